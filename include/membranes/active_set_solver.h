@@ -1,0 +1,149 @@
+#ifndef membranes_active_set_solver_h
+#define membranes_active_set_solver_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discrete_action.h>
+#include <membranes/discretization.h>
+#include <membranes/linear_solver.h>
+#include <membranes/parameters.h>
+#include <membranes/problem_data.h>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The primal-dual active set method (a semismooth Newton method) for the
+   * discrete variational inequality (3.4), as in deal.II's step-41 but on
+   * the coupled pair (u1, u2).
+   *
+   * With W_a = u1h(a) − u2h(a) and the nodal multiplier Λ_a = λ_a of (4.5),
+   * the active set is
+   *
+   *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a,
+   *
+   * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
+   * obstacle problem for w = u1 − u2, SPEC §1), so the test does not depend
+   * on how the data are scaled. On active vertices the constraint
+   * u1(a) = u2(a) is a line of an AffineConstraints object, together with
+   * hanging-node constraints and the boundary values u1 = g_h, u2 = g2_h;
+   * on inactive vertices both equations hold, i.e. Λ_a = 0. Condensing
+   * the constraint adds the equations of u1 and u2 at a, so the solution of
+   * each iteration satisfies Prop. 12 (λ from either membrane) by
+   * construction.
+   *
+   * The iteration stops when the active set repeats and the relative KKT
+   * residual (see kkt_residual()) is at most `Tolerance`. If that does not
+   * happen within `Max active set iterations`, solve() throws.
+   */
+  template <int dim>
+  class ActiveSetSolver
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    /** What one solve() did. */
+    struct Statistics
+    {
+      unsigned int iterations        = 0; ///< Active set iterations.
+      unsigned int linear_iterations = 0; ///< CG iterations, summed.
+      double       kkt_residual      = 0; ///< Relative KKT residual at the end.
+      double       assembly_time     = 0; ///< Seconds spent assembling.
+      double       solve_time = 0; ///< Seconds in linear solves and updates.
+    };
+
+    ActiveSetSolver(const Parameters::Solver  &parameters,
+                    const Discretization<dim> &discretization,
+                    const ProblemData<dim>    &data,
+                    const ConditionalOStream  &pcout,
+                    const MPI_Comm             mpi_communicator);
+
+    /**
+     * Sparsity pattern and matrix for the current mesh; the pattern has room
+     * for any active set.
+     */
+    void
+    setup(const DoFHandler<dim>     &dof_handler,
+          const IndexSet            &locally_owned_dofs,
+          const IndexSet            &locally_relevant_dofs,
+          const DiscreteAction<dim> &action);
+
+    /**
+     * Run the active set method from the initial guess @p solution (locally
+     * owned entries) and the initial active set @p active_set (u1 DoFs of
+     * active vertices). On return both hold the converged iterate, and
+     * @p action holds λ_a for it.
+     */
+    Statistics
+    solve(DiscreteAction<dim> &action,
+          VectorType          &solution,
+          IndexSet            &active_set);
+
+    /**
+     * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
+     * mesh's solution and λ_h interpolated onto it (nested iteration):
+     * vertices between two active ones stay active, the others are decided
+     * by the same test as in the iteration.
+     */
+    IndexSet
+    initial_active_set(const DiscreteAction<dim> &action,
+                       const VectorType          &ghosted_solution,
+                       const VectorType          &ghosted_lambda_h) const;
+
+    /**
+     * The relative KKT residual of an iterate, the largest of
+     * - equilibrium: ‖r‖₂ / F₂ with r_a = λ_a d_a from both membranes on
+     *   inactive vertices and the difference of the two on active ones;
+     * - primal feasibility: max(−W_a)⁺ / max|U|;
+     * - dual feasibility: max(−λ_a d_a)⁺ / F_∞;
+     * - complementarity: max |λ_a d_a W_a| / (F_∞ max|U|);
+     * with F₂, F_∞ the force scales of DiscreteAction.
+     */
+    double
+    kkt_residual(const DiscreteAction<dim> &action,
+                 const VectorType          &ghosted_solution,
+                 const IndexSet            &active_set) const;
+
+  private:
+    /**
+     * {a : Λ_a − c_a W_a > 0} for the iterate @p ghosted_solution, with
+     * Λ_a = @p lambda(k) for the k-th vertex of @p action.
+     */
+    template <typename LambdaOfVertex>
+    IndexSet
+    active_set_for(const DiscreteAction<dim> &action,
+                   const VectorType          &ghosted_solution,
+                   const LambdaOfVertex      &lambda) const;
+
+    /** Hanging-node, contact and boundary constraints for @p active_set. */
+    void
+    make_constraints(const DiscreteAction<dim> &action,
+                     const IndexSet            &active_set);
+
+    /** The condensed system for the current constraints. */
+    void
+    assemble_system();
+
+    const Parameters::Solver  &parameters;
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
+    const ConditionalOStream  &pcout;
+    const MPI_Comm             mpi_communicator;
+
+    SmartPointer<const DoFHandler<dim>> dof_handler;
+    IndexSet                            locally_owned_dofs;
+    IndexSet                            locally_relevant_dofs;
+
+    AffineConstraints<double>      constraints;
+    TrilinosWrappers::SparseMatrix system_matrix;
+    VectorType                     system_rhs;
+    LinearSolver<dim>              linear_solver;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,126 @@
+#ifndef membranes_discrete_action_h
+#define membranes_discrete_action_h
+
+#include <array>
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discretization.h>
+#include <membranes/problem_data.h>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The discrete action λ_h by the local postprocessing (4.5) of the paper.
+   *
+   * For every interior vertex a (the set V_h; with hanging nodes, every
+   * unconstrained interior vertex), with φ_a its hat function and
+   * d_a = ∫ φ_a = meas(D_a) (the lumped mass; with hanging nodes the row
+   * sum of the constrained mass matrix),
+   *
+   *   λ_a d_a = μ1 ∫ ∇u1h·∇φ_a − ∫ f1 φ_a          (membrane 1)
+   *           = −(μ2 ∫ ∇u2h·∇φ_a − ∫ f2 φ_a)        (membrane 2).
+   *
+   * Both right-hand sides are computed; Prop. 12 says that they agree for
+   * the solution of the discrete variational inequality (3.4), and
+   * λ_a ≥ 0 and λ_a (u1h − u2h)(a) = 0 (4.8). λ_h is the function equal to
+   * λ_a on the dual cell D_a.
+   *
+   * The same nodal quantities are the multipliers of the active set solver:
+   * λ_a d_a is the residual of membrane 1's equation at a.
+   *
+   * Everything is stored for the locally owned vertices of V_h only, in the
+   * order of their u1 DoF index.
+   */
+  template <int dim>
+  class DiscreteAction
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
+    struct Vertex
+    {
+      /** DoF of u1 (index 0) and of u2 (index 1) at a. */
+      std::array<types::global_dof_index, 2> dof;
+      /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
+      double dual_cell_measure;
+      /** ∫ |∇φ_a|², the scale of the stiffness matrix at a. */
+      double stiffness_diagonal;
+    };
+
+    DiscreteAction(const Discretization<dim> &discretization,
+                   const ProblemData<dim>    &data);
+
+    /**
+     * Find V_h and compute d_a on the current mesh. @p hanging_node_constraints
+     * condense the hat functions of constrained vertices into their parents.
+     */
+    void
+    reinit(const DoFHandler<dim>           &dof_handler,
+           const AffineConstraints<double> &hanging_node_constraints,
+           const IndexSet                  &locally_owned_dofs,
+           const MPI_Comm                   mpi_communicator);
+
+    /** Compute λ_a by (4.5) from both membranes for @p ghosted_solution. */
+    void
+    compute(const VectorType &ghosted_solution);
+
+    /** The locally owned vertices of V_h. */
+    const std::vector<Vertex> &
+    vertices() const;
+
+    /** The u1 DoFs of the locally owned vertices of V_h. */
+    const IndexSet &
+    dual_mesh_vertices() const;
+
+    /**
+     * Write λ_a into both DoF slots (u1 and u2) of every vertex a of V_h in
+     * @p lambda_h, a vector with the layout of the solution; zero
+     * elsewhere.
+     */
+    void
+    fill_nodal_vector(VectorType &lambda_h) const;
+
+    /** λ_a from membrane i (0 or 1) for the k-th vertex of vertices(). */
+    double
+    lambda_from_membrane(const unsigned int i, const unsigned int k) const;
+
+    /** λ_a: the mean of the two formulas of (4.5) (they agree by Prop. 12). */
+    double
+    lambda(const unsigned int k) const;
+
+    /**
+     * The size of the forces at the interior vertices, max over a and i of
+     * |μ_i ∫ ∇u_ih·∇φ_a| and |∫ f_i φ_a|: what residuals and λ_a d_a are
+     * measured against. Global over all processes.
+     */
+    double
+    force_scale() const;
+
+    /** The same in the Euclidean norm over all vertices and membranes. */
+    double
+    force_scale_l2() const;
+
+  private:
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
+
+    SmartPointer<const DoFHandler<dim>>           dof_handler;
+    SmartPointer<const AffineConstraints<double>> hanging_node_constraints;
+    IndexSet                                      locally_owned_dofs;
+    MPI_Comm                                      mpi_communicator;
+
+    std::vector<Vertex>                interior_vertices;
+    IndexSet                           interior_vertex_dofs;
+    std::array<std::vector<double>, 2> lambda_i;
+    double                             max_force;
+    double                             l2_force;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,60 @@
+#ifndef membranes_discretization_h
+#define membranes_discretization_h
+
+#include <deal.II/base/quadrature.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/mapping.h>
+#include <deal.II/grid/tria.h>
+#include <membranes/parameters.h>
+#include <memory>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The finite element setting of §3 of the paper: one mesh T_h and the
+   * same continuous piecewise-linear space for both membranes, P1 on
+   * triangles (FE_SimplexP, MappingFE, QGaussSimplex) or Q1 on
+   * quadrilaterals (FE_Q, MappingQ1, QGauss).
+   *
+   * Both membranes live in one FESystem with two components (u1, u2) on one
+   * DoFHandler. This is what makes the contact constraint u1(a) = u2(a) on
+   * active vertices an ordinary AffineConstraints line between two DoFs of
+   * the same handler, to be merged with hanging-node and boundary
+   * constraints, and gives one sparsity pattern, one matrix and one
+   * SolutionTransfer for the pair.
+   */
+  template <int dim>
+  class Discretization
+  {
+  public:
+    explicit Discretization(const Parameters::CellType cell_type);
+
+    const Parameters::CellType           cell_type;
+    const std::unique_ptr<FESystem<dim>> fe;
+    const std::unique_ptr<Mapping<dim>>  mapping;
+    /** Quadrature for the stiffness matrix and the loads (exact for P1/Q1
+     * stiffness, degree 3 for smooth loads). */
+    const Quadrature<dim> cell_quadrature;
+  };
+
+
+
+  /**
+   * The coarse mesh of the scene's domain, refined `Initial refinement`
+   * times: the square (−1,1)², the L-shape (−1,1)² minus [0,1)², the unit
+   * disk (its circle kept as a SphericalManifold, so refinement follows the
+   * curved boundary), or a Gmsh file. Quadrilateral meshes are split into
+   * triangles (GridGenerator::convert_hypercube_to_simplex_mesh) when the
+   * scene asks for triangles; a triangle mesh with `Cell type =
+   * quadrilateral`, a mixed mesh, or a file that cannot be read is an
+   * InputError naming the entry.
+   */
+  template <int dim>
+  void
+  create_mesh(const Parameters::Geometry &geometry,
+              Triangulation<dim>         &triangulation);
+} // namespace membranes
+
+#endif

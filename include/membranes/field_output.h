@@ -1,0 +1,49 @@
+#ifndef membranes_field_output_h
+#define membranes_field_output_h
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discretization.h>
+#include <membranes/parameters.h>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * Field output for ParaView (SPEC §3.4): one VTU file per cycle with u1,
+   * u2, w = u1 − u2, λ_h (the nodal values λ_a) and the active set
+   * indicator, and a .pvd file that lists the cycles. Each file is written
+   * to a temporary name and renamed, so that no half-written file is left.
+   */
+  template <int dim>
+  class FieldOutput
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    FieldOutput(const Parameters::Output  &parameters,
+                const Discretization<dim> &discretization);
+
+    /**
+     * Write cycle @p cycle. @p contact_fields has the layout of the solution
+     * and holds λ_a in the u1 slot and the active set indicator (1 or 0) in
+     * the u2 slot of every vertex; all vectors are ghosted.
+     */
+    void
+    write(const unsigned int     cycle,
+          const DoFHandler<dim> &dof_handler,
+          const VectorType      &ghosted_solution,
+          const VectorType      &contact_fields);
+
+  private:
+    const Parameters::Output                   &parameters;
+    const Discretization<dim>                  &discretization;
+    std::vector<std::pair<double, std::string>> cycles_written;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,89 @@
+#ifndef membranes_linear_solver_h
+#define membranes_linear_solver_h
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/parameters.h>
+#include <memory>
+#include <string>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The linear solves inside the active set method: the condensed,
+   * symmetric positive definite system of one iteration.
+   *
+   * - `direct`: UMFPACK (SuiteSparse) on a copy of the matrix; one process
+   *   only.
+   * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
+   *   multigrid, with one constant near-null-space mode per membrane.
+   * - `auto`: direct up to direct_solver_dof_limit DoFs on one process,
+   *   cg-amg otherwise.
+   *
+   * CG stops at the residual norm it is given (the active set method
+   * relates it to the size of the forces, not to the right-hand side, whose
+   * rows of constrained boundary DoFs can dwarf the interior ones on fine
+   * meshes), and starts from the vector it is given (the previous active set
+   * iterate, or the interpolated solution of the previous mesh), so later
+   * iterations of the active set method are cheap.
+   */
+  template <int dim>
+  class LinearSolver
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+    using MatrixType = TrilinosWrappers::SparseMatrix;
+
+    /** Largest problem that `auto` hands to UMFPACK. */
+    static constexpr types::global_dof_index direct_solver_dof_limit = 10000;
+
+    LinearSolver(const Parameters::LinearSolverType type,
+                 const MPI_Comm                     mpi_communicator);
+
+    /** Choose the method for the current problem size. */
+    void
+    reinit(const DoFHandler<dim> &dof_handler);
+
+    /**
+     * Solve `matrix x = rhs`, starting from @p x, to a residual norm of at
+     * most @p tolerance (CG; but never below 1e-14 ‖rhs‖). Returns the
+     * number of CG iterations (0 for the direct solver).
+     */
+    unsigned int
+    solve(const MatrixType &matrix,
+          VectorType       &x,
+          const VectorType &rhs,
+          const double      tolerance);
+
+    /** "direct" or "cg-amg": what the last reinit() chose. */
+    std::string
+    method() const;
+
+  private:
+    void
+    solve_direct(const MatrixType &matrix,
+                 VectorType       &x,
+                 const VectorType &rhs);
+
+    unsigned int
+    solve_cg_amg(const MatrixType &matrix,
+                 VectorType       &x,
+                 const VectorType &rhs,
+                 const double      tolerance);
+
+    const Parameters::LinearSolverType type;
+    const MPI_Comm                     mpi_communicator;
+
+    bool                           use_direct;
+    std::vector<std::vector<bool>> constant_modes;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,105 @@
+#ifndef membranes_membrane_problem_h
+#define membranes_membrane_problem_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/numerics/solution_transfer.h>
+#include <membranes/active_set_solver.h>
+#include <membranes/discrete_action.h>
+#include <membranes/discretization.h>
+#include <membranes/error_norms.h>
+#include <membranes/field_output.h>
+#include <membranes/parameters.h>
+#include <membranes/problem_data.h>
+#include <membranes/report.h>
+#include <memory>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The driver of one run: the contact problem (1.1) between two membranes,
+   * discretized by P1/Q1 finite elements (the reduced problem (3.4)),
+   * solved by the primal-dual active set method on a sequence of meshes,
+   * with the action λ_h by the local postprocessing (4.5).
+   *
+   * run() is the whole story: for each cycle, set up DoFs and constraints,
+   * transfer the previous solution and active set to the new mesh (nested
+   * iteration), solve, postprocess (λ_h, the discrete identities, errors),
+   * add a row to the report, write fields, refine.
+   *
+   * Data layout is that of deal.II's step-40: locally owned and locally
+   * relevant index sets, Trilinos vectors and matrices, ghosted vectors for
+   * reading, and output on the first process only; the triangulation is
+   * serial for now.
+   */
+  template <int dim>
+  class MembraneProblem
+  {
+  public:
+    explicit MembraneProblem(const Parameters::All &parameters);
+
+    void
+    run();
+
+  private:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    void
+    make_grid();
+    void
+    create_output_directory() const;
+    void
+    setup_system();
+    void
+    transfer_solution();
+    void
+    solve();
+    void
+    postprocess();
+    void
+    output_results(const unsigned int cycle);
+    void
+    refine_grid();
+
+    const Parameters::All &parameters;
+    MPI_Comm               mpi_communicator;
+    ConditionalOStream     pcout;
+
+    const ProblemData<dim>    data;
+    const Discretization<dim> discretization;
+
+    Triangulation<dim>        triangulation;
+    DoFHandler<dim>           dof_handler;
+    IndexSet                  locally_owned_dofs;
+    IndexSet                  locally_relevant_dofs;
+    AffineConstraints<double> hanging_node_constraints;
+
+    /** (u1h, u2h): locally owned entries, and a ghosted copy for reading. */
+    VectorType solution;
+    VectorType ghosted_solution;
+    /** λ_a in both DoF slots of every vertex a of V_h (ghosted). */
+    VectorType lambda_h;
+    /** u1 DoFs of the active vertices. */
+    IndexSet active_set;
+
+    DiscreteAction<dim>  action;
+    ActiveSetSolver<dim> active_set_solver;
+    ErrorNorms<dim>      error_norms;
+    Report               report;
+    FieldOutput<dim>     field_output;
+
+    /** Carries (u_h, λ_h) from one mesh to the next. */
+    std::unique_ptr<SolutionTransfer<dim, VectorType>> solution_transfer;
+    std::vector<VectorType>                            previous_mesh_vectors;
+
+    /** The row of the current cycle. */
+    CycleRecord record;
+  };
+} // namespace membranes
+
+#endif

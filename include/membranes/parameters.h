@@ -1,0 +1,188 @@
+#ifndef membranes_parameters_h
+#define membranes_parameters_h
+
+#include <deal.II/base/parameter_handler.h>
+#include <stdexcept>
+#include <string>
+
+/**
+ * The run-time parameters of a scene. Each struct mirrors one subsection of
+ * the parameter file (SPEC §3.2); `declare_parameters()` documents every
+ * entry, `parse_parameters()` reads it into typed fields and rejects values
+ * that the pattern cannot catch (e.g. a tension that is not positive) with
+ * a one-line message naming the entry.
+ */
+namespace membranes::Parameters
+{
+  using dealii::ParameterHandler;
+
+  /**
+   * An error in a scene. Its message is one line that names the entry as
+   * `Subsection/Entry`, the offending value and what is allowed.
+   */
+  class InputError : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+  /** The InputError for `entry = value`, which should be `allowed`. */
+  InputError
+  invalid_entry(const std::string &entry,
+                const std::string &value,
+                const std::string &allowed);
+
+  enum class Domain
+  {
+    square,
+    lshape,
+    disk,
+    file
+  };
+
+  enum class CellType
+  {
+    quadrilateral,
+    triangle
+  };
+
+  /** Subsection `Geometry`: the domain ω and its initial mesh. */
+  struct Geometry
+  {
+    Domain domain; ///< Square (−1,1)², L-shape, unit disk, or a Gmsh file.
+    std::string  mesh_file; ///< Gmsh `.msh` file, read when `domain == file`.
+    CellType     cell_type; ///< Q1 on quadrilaterals or P1 on triangles.
+    unsigned int initial_refinement; ///< Global refinements of the coarse mesh.
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /** Subsection `Problem`: tensions, loads and boundary heights of (1.1). */
+  struct Problem
+  {
+    double mu1; ///< Tension μ1 > 0 of membrane 1.
+    double mu2; ///< Tension μ2 > 0 of membrane 2.
+    std::string
+      function_constants; ///< `name=value` pairs usable in expressions.
+    std::string f1;       ///< Load f1(x, y).
+    std::string f2;       ///< Load f2(x, y).
+    std::string g;        ///< Height g ≥ 0 of membrane 1 on ∂ω.
+    std::string g2;       ///< Height g2 ≤ g of membrane 2 on ∂ω.
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /** Subsection `Exact solution`: (u1, u2, λ) when known, for error norms. */
+  struct ExactSolution
+  {
+    bool        known;  ///< Compute error norms against the expressions below.
+    std::string u1;     ///< Exact u1(x, y).
+    std::string u2;     ///< Exact u2(x, y).
+    std::string lambda; ///< Exact action λ(x, y).
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  enum class SolverMethod
+  {
+    coupled,
+    decoupled
+  };
+
+  enum class LinearSolverType
+  {
+    automatic,
+    direct,
+    cg_amg
+  };
+
+  /** Subsection `Solver`: the primal-dual active set method (SPEC §2.2). */
+  struct Solver
+  {
+    SolverMethod method; ///< Coupled (u1, u2) system or decoupled (s, w).
+    LinearSolverType
+                 linear_solver; ///< UMFPACK, CG with AMG, or chosen by size.
+    double       tolerance;     ///< Relative KKT residual to reach.
+    unsigned int max_active_set_iterations; ///< Give up after this many.
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  enum class RefinementStrategy
+  {
+    global,
+    adaptive
+  };
+
+  enum class Marking
+  {
+    bulk,
+    fixed_fraction
+  };
+
+  enum class Estimator
+  {
+    residual,
+    flux
+  };
+
+  /** Subsection `Refinement`: the sequence of meshes of one run. */
+  struct Refinement
+  {
+    RefinementStrategy strategy; ///< Global or adaptive refinement.
+    unsigned int       cycles;   ///< Number of meshes (cycles) of the run.
+    Marking            marking;  ///< Dörfler (bulk) or fixed fraction.
+    double             bulk_parameter; ///< Dörfler parameter θ in (0, 1].
+    unsigned int       max_dofs;       ///< Stop before exceeding; 0 = no limit.
+    Estimator          estimator; ///< Which a posteriori estimator drives it.
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /** Subsection `Output`: what a run writes, and where. */
+  struct Output
+  {
+    std::string directory; ///< Where report.csv and VTU files go.
+    bool        report;    ///< Write report.csv.
+    bool        write_vtu; ///< Write VTU files and a .pvd over cycles.
+    bool        flux_reconstruction; ///< Compute and write the fluxes t_ih.
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+
+  /** All subsections of a scene. */
+  struct All
+  {
+    Geometry      geometry;
+    Problem       problem;
+    ExactSolution exact_solution;
+    Solver        solver;
+    Refinement    refinement;
+    Output        output;
+
+    static void
+    declare_parameters(ParameterHandler &prm);
+    void
+    parse_parameters(ParameterHandler &prm);
+  };
+} // namespace membranes::Parameters
+
+#endif

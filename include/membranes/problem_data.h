@@ -1,0 +1,87 @@
+#ifndef membranes_problem_data_h
+#define membranes_problem_data_h
+
+#include <deal.II/base/function.h>
+#include <deal.II/base/function_parser.h>
+#include <deal.II/fe/mapping.h>
+#include <deal.II/grid/tria.h>
+#include <membranes/parameters.h>
+#include <memory>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The data of problem (1.1): tensions μ1, μ2, loads f1, f2, boundary
+   * heights g (membrane 1) and g2 (membrane 2, 0 in the paper), and, when
+   * known, the exact solution (u1, u2, λ).
+   *
+   * Every function is a deal.II FunctionParser expression in x, y with the
+   * scene's `Function constants` and the names `mu1`, `mu2`, `pi`, so that a
+   * manufactured solution written in terms of the tensions stays exact for
+   * any μ1, μ2. Expressions are parsed and evaluated once on construction;
+   * one that does not parse is an InputError naming its entry. Gradients of
+   * the exact solution (for H1 errors) come from fourth-order finite
+   * differences with step 1e-5, accurate to about 1e-11 for smooth data.
+   */
+  template <int dim>
+  class ProblemData
+  {
+  public:
+    ProblemData(const Parameters::Problem       &problem,
+                const Parameters::ExactSolution &exact);
+
+    /** Load f_i of membrane i (i = 0 or 1 for membranes 1 and 2). */
+    const Function<dim> &
+    load(const unsigned int i) const;
+
+    /**
+     * The boundary values as one function with two components (g, g2), as
+     * VectorTools::interpolate_boundary_values wants them for the FESystem
+     * that holds (u1, u2).
+     */
+    const Function<dim> &
+    boundary_values() const;
+
+    /**
+     * Check g ≥ 0 and g − g2 ≥ 0 at the boundary vertices of @p triangulation
+     * (where g_h and g2_h interpolate them) and at points along every
+     * boundary face, and that all data are finite there. Throws an
+     * InputError naming `Problem/g` or `Problem/g2` otherwise.
+     */
+    void
+    check_boundary_data(const Triangulation<dim> &triangulation) const;
+
+    bool
+    exact_solution_known() const;
+
+    /** Exact displacement u_i (i = 0 or 1); only when known. */
+    const Function<dim> &
+    exact_displacement(const unsigned int i) const;
+
+    /** Exact action λ; only when known. */
+    const Function<dim> &
+    exact_lambda() const;
+
+    /** μ1 and μ2 as `mu[0]`, `mu[1]`. */
+    const std::array<double, 2> mu;
+
+    /** μ̄ = μ1 μ2 / (μ1 + μ2), the tension of the obstacle problem for w. */
+    const double mu_bar;
+
+  private:
+    class BoundaryValues;
+
+    std::array<std::unique_ptr<FunctionParser<dim>>, 2> f;
+    std::unique_ptr<FunctionParser<dim>>                g;
+    std::unique_ptr<FunctionParser<dim>>                g2;
+    std::unique_ptr<Function<dim>>                      g_and_g2;
+
+    const bool                                          known;
+    std::array<std::unique_ptr<FunctionParser<dim>>, 2> exact_u;
+    std::unique_ptr<FunctionParser<dim>>                exact_action;
+  };
+} // namespace membranes
+
+#endif

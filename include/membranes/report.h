@@ -1,0 +1,85 @@
+#ifndef membranes_report_h
+#define membranes_report_h
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/convergence_table.h>
+#include <deal.II/base/types.h>
+#include <membranes/parameters.h>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /** Everything a run records about one cycle (one row of report.csv). */
+  struct CycleRecord
+  {
+    unsigned int            cycle                 = 0;
+    unsigned int            cells                 = 0;
+    types::global_dof_index dofs                  = 0;
+    unsigned int            active_set_iterations = 0;
+    unsigned int            active_vertices       = 0;
+    unsigned int            linear_iterations     = 0;
+    /** Wall time of the cycle's solve phases (not of output writing). */
+    double wall_time = 0;
+    /** The same, summed over this and all previous cycles. */
+    double cumulative_wall_time = 0;
+    double time_setup = 0, time_assembly = 0, time_solve = 0,
+           time_postprocess = 0;
+
+    /** Errors; empty when the exact solution is not known. */
+    std::optional<double> err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2,
+      err_lambda_L2;
+    /** A posteriori estimator and effectivity (adaptivity, not yet). */
+    std::optional<double> estimator, effectivity;
+
+    /** Relative KKT residual of the active set solver at the end. */
+    double kkt_residual = 0;
+    /** min_a (u1h − u2h)(a) and min_a λ_a over V_h. */
+    double min_w = 0, min_lambda = 0;
+    /** max_a |λ_1a − λ_2a| d_a / F, F the force scale of (4.5) (Prop. 12). */
+    double prop12_defect = 0;
+    /** max_a |λ_a d_a (u1h − u2h)(a)| / (F max|u_h|), (4.8). */
+    double complementarity_defect = 0;
+  };
+
+
+
+  /**
+   * The report of a run (SPEC §3.3): report.csv with one row per cycle,
+   * rewritten after every cycle (to a temporary name, then renamed, so that
+   * a stopped run never leaves a half-written file), and at the end the
+   * same numbers as a deal.II ConvergenceTable with observed rates in h
+   * (h ~ DoFs^{-1/2}) on the terminal.
+   */
+  class Report
+  {
+  public:
+    Report(const Parameters::Output &parameters,
+           const ConditionalOStream &pcout);
+
+    /** Add the row of one cycle; write report.csv if asked for. */
+    void
+    add(const CycleRecord &record);
+
+    /** Print the table with convergence rates. */
+    void
+    print_convergence_table();
+
+    /** The column names of report.csv, in order. */
+    static const std::vector<std::string> &
+    column_names();
+
+  private:
+    void
+    write_csv() const;
+
+    const Parameters::Output &parameters;
+    const ConditionalOStream &pcout;
+    std::vector<CycleRecord>  records;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,262 @@
+#include <algorithm>
+#include <deal.II/base/mpi.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_values.h>
+#include <membranes/discrete_action.h>
+
+namespace membranes
+{
+  template <int dim>
+  DiscreteAction<dim>::DiscreteAction(const Discretization<dim> &discretization,
+                                      const ProblemData<dim>    &data)
+    : discretization(discretization)
+    , data(data)
+    , max_force(0)
+    , l2_force(0)
+  {}
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::reinit(
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const IndexSet                  &locally_owned_dofs,
+    const MPI_Comm                   mpi_communicator)
+  {
+    this->dof_handler              = &dof_handler;
+    this->hanging_node_constraints = &hanging_node_constraints;
+    this->locally_owned_dofs       = locally_owned_dofs;
+    this->mpi_communicator         = mpi_communicator;
+
+    const FiniteElement<dim> &fe = *discretization.fe;
+    IndexSet                  boundary_dofs;
+    DoFTools::extract_boundary_dofs(dof_handler,
+                                    ComponentMask(),
+                                    boundary_dofs);
+
+    // d_a = ∫ φ_a as the row sums of the mass matrix, condensed with the
+    // hanging node constraints, and the diagonal ∫ |∇φ_a|².
+    VectorType dual_cell_measure(locally_owned_dofs, mpi_communicator);
+    VectorType stiffness_diagonal(locally_owned_dofs, mpi_communicator);
+
+    FEValues<dim>                        fe_values(*discretization.mapping,
+                            fe,
+                            discretization.cell_quadrature,
+                            update_values | update_gradients |
+                              update_JxW_values);
+    const unsigned int                   dofs_per_cell = fe.n_dofs_per_cell();
+    std::vector<types::global_dof_index> local_dof_indices(dofs_per_cell);
+    Vector<double>                       local_measure(dofs_per_cell);
+    Vector<double>                       local_stiffness(dofs_per_cell);
+    std::vector<std::array<types::global_dof_index, 2>> candidates;
+
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          cell->get_dof_indices(local_dof_indices);
+          local_measure   = 0;
+          local_stiffness = 0;
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            for (const unsigned int i : fe_values.dof_indices())
+              {
+                const unsigned int c = fe.system_to_component_index(i).first;
+                local_measure(i) +=
+                  fe_values.shape_value_component(i, q, c) * fe_values.JxW(q);
+                local_stiffness(i) +=
+                  fe_values.shape_grad_component(i, q, c).norm_square() *
+                  fe_values.JxW(q);
+              }
+          hanging_node_constraints.distribute_local_to_global(
+            local_measure, local_dof_indices, dual_cell_measure);
+          stiffness_diagonal.add(local_dof_indices, local_stiffness);
+
+          for (const unsigned int v : cell->vertex_indices())
+            candidates.push_back(
+              {{local_dof_indices[fe.component_to_system_index(0, v)],
+                local_dof_indices[fe.component_to_system_index(1, v)]}});
+        }
+    dual_cell_measure.compress(VectorOperation::add);
+    stiffness_diagonal.compress(VectorOperation::add);
+
+    // V_h: owned, interior, unconstrained vertices, each once.
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()),
+                     candidates.end());
+    interior_vertices.clear();
+    interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
+    for (const auto &dofs : candidates)
+      if (locally_owned_dofs.is_element(dofs[0]) &&
+          !boundary_dofs.is_element(dofs[0]) &&
+          !hanging_node_constraints.is_constrained(dofs[0]))
+        {
+          interior_vertices.push_back(
+            {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
+          interior_vertex_dofs.add_index(dofs[0]);
+        }
+    interior_vertex_dofs.compress();
+
+    for (auto &lambda : lambda_i)
+      lambda.assign(interior_vertices.size(), 0.0);
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::compute(const VectorType &ghosted_solution)
+  {
+    const FiniteElement<dim> &fe = *discretization.fe;
+    // The two terms of (4.5), assembled as vectors over all DoFs:
+    // stiffness_term_i = μ_i ∫ ∇u_ih·∇φ and load_term_i = ∫ f_i φ.
+    VectorType stiffness_term(locally_owned_dofs, mpi_communicator);
+    VectorType load_term(locally_owned_dofs, mpi_communicator);
+
+    FEValues<dim>      fe_values(*discretization.mapping,
+                            fe,
+                            discretization.cell_quadrature,
+                            update_values | update_gradients |
+                              update_quadrature_points | update_JxW_values);
+    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
+    const unsigned int n_q_points    = fe_values.n_quadrature_points;
+    std::vector<types::global_dof_index>       local_dof_indices(dofs_per_cell);
+    Vector<double>                             local_stiffness(dofs_per_cell);
+    Vector<double>                             local_load(dofs_per_cell);
+    std::array<std::vector<Tensor<1, dim>>, 2> gradients;
+    std::array<std::vector<double>, 2>         loads;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        gradients[i].resize(n_q_points);
+        loads[i].resize(n_q_points);
+      }
+    const std::array<FEValuesExtractors::Scalar, 2> membrane{
+      {FEValuesExtractors::Scalar(0), FEValuesExtractors::Scalar(1)}};
+
+    for (const auto &cell : dof_handler->active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          cell->get_dof_indices(local_dof_indices);
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              fe_values[membrane[i]].get_function_gradients(ghosted_solution,
+                                                            gradients[i]);
+              data.load(i).value_list(fe_values.get_quadrature_points(),
+                                      loads[i]);
+            }
+          local_stiffness = 0;
+          local_load      = 0;
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            for (const unsigned int k : fe_values.dof_indices())
+              {
+                const unsigned int c = fe.system_to_component_index(k).first;
+                local_stiffness(k) += data.mu[c] * gradients[c][q] *
+                                      fe_values.shape_grad_component(k, q, c) *
+                                      fe_values.JxW(q);
+                local_load(k) += loads[c][q] *
+                                 fe_values.shape_value_component(k, q, c) *
+                                 fe_values.JxW(q);
+              }
+          hanging_node_constraints->distribute_local_to_global(
+            local_stiffness, local_dof_indices, stiffness_term);
+          hanging_node_constraints->distribute_local_to_global(
+            local_load, local_dof_indices, load_term);
+        }
+    stiffness_term.compress(VectorOperation::add);
+    load_term.compress(VectorOperation::add);
+
+    double local_max = 0, local_sum_of_squares = 0;
+    for (unsigned int k = 0; k < interior_vertices.size(); ++k)
+      {
+        const Vertex &a = interior_vertices[k];
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            const double stiffness = stiffness_term[a.dof[i]];
+            const double load      = load_term[a.dof[i]];
+            const double sign      = (i == 0 ? 1. : -1.);
+            lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
+            local_max =
+              std::max({local_max, std::abs(stiffness), std::abs(load)});
+            local_sum_of_squares +=
+              std::max(stiffness * stiffness, load * load);
+          }
+      }
+    max_force = Utilities::MPI::max(local_max, mpi_communicator);
+    l2_force =
+      std::sqrt(Utilities::MPI::sum(local_sum_of_squares, mpi_communicator));
+  }
+
+
+
+  template <int dim>
+  const std::vector<typename DiscreteAction<dim>::Vertex> &
+  DiscreteAction<dim>::vertices() const
+  {
+    return interior_vertices;
+  }
+
+
+
+  template <int dim>
+  const IndexSet &
+  DiscreteAction<dim>::dual_mesh_vertices() const
+  {
+    return interior_vertex_dofs;
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::fill_nodal_vector(VectorType &lambda_h) const
+  {
+    lambda_h = 0;
+    for (unsigned int k = 0; k < interior_vertices.size(); ++k)
+      for (const auto dof : interior_vertices[k].dof)
+        lambda_h[dof] = lambda(k);
+    lambda_h.compress(VectorOperation::insert);
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::lambda_from_membrane(const unsigned int i,
+                                            const unsigned int k) const
+  {
+    return lambda_i[i][k];
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::lambda(const unsigned int k) const
+  {
+    return (lambda_i[0][k] + lambda_i[1][k]) / 2;
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::force_scale() const
+  {
+    return max_force;
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::force_scale_l2() const
+  {
+    return l2_force;
+  }
+
+
+
+  template class DiscreteAction<2>;
+} // namespace membranes

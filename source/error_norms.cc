@@ -1,0 +1,91 @@
+#include <cmath>
+#include <deal.II/base/mpi.h>
+#include <deal.II/fe/fe_values.h>
+#include <membranes/error_norms.h>
+
+namespace membranes
+{
+  template <int dim>
+  ErrorNorms<dim>::ErrorNorms(const Discretization<dim> &discretization,
+                              const ProblemData<dim>    &data)
+    : discretization(discretization)
+    , data(data)
+    , dual_quadrature(discretization.fe->reference_cell(), 2)
+  {}
+
+
+
+  template <int dim>
+  typename ErrorNorms<dim>::Errors
+  ErrorNorms<dim>::compute(const DoFHandler<dim> &dof_handler,
+                           const VectorType      &ghosted_solution,
+                           const VectorType      &lambda_h,
+                           const IndexSet        &dual_mesh_vertices,
+                           const MPI_Comm         mpi_communicator) const
+  {
+    const FiniteElement<dim> &fe = *discretization.fe;
+    FEValues<dim>             fe_values(*discretization.mapping,
+                            fe,
+                            dual_quadrature.quadrature(),
+                            update_values | update_gradients |
+                              update_quadrature_points | update_JxW_values);
+    const unsigned int        n_q_points = fe_values.n_quadrature_points;
+    std::vector<types::global_dof_index> local_dof_indices(
+      fe.n_dofs_per_cell());
+
+    std::array<std::vector<double>, 2>         uh, u;
+    std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
+    std::vector<double>                        lambda(n_q_points);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        uh[i].resize(n_q_points);
+        u[i].resize(n_q_points);
+        grad_uh[i].resize(n_q_points);
+        grad_u[i].resize(n_q_points);
+      }
+
+    // Squared norms, summed over the locally owned cells.
+    std::array<double, 5> squares{};
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          cell->get_dof_indices(local_dof_indices);
+          const auto &points = fe_values.get_quadrature_points();
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              const FEValuesExtractors::Scalar membrane(i);
+              fe_values[membrane].get_function_values(ghosted_solution, uh[i]);
+              fe_values[membrane].get_function_gradients(ghosted_solution,
+                                                         grad_uh[i]);
+              data.exact_displacement(i).value_list(points, u[i]);
+              data.exact_displacement(i).gradient_list(points, grad_u[i]);
+            }
+          data.exact_lambda().value_list(points, lambda);
+
+          for (unsigned int q = 0; q < n_q_points; ++q)
+            {
+              const double JxW = fe_values.JxW(q);
+              for (unsigned int i = 0; i < 2; ++i)
+                {
+                  squares[i] +=
+                    (grad_u[i][q] - grad_uh[i][q]).norm_square() * JxW;
+                  squares[2 + i] += std::pow(u[i][q] - uh[i][q], 2) * JxW;
+                }
+              const types::global_dof_index a =
+                local_dof_indices[fe.component_to_system_index(
+                  0, dual_quadrature.vertex_of_point(q))];
+              if (dual_mesh_vertices.is_element(a))
+                squares[4] += std::pow(lambda[q] - lambda_h[a], 2) * JxW;
+            }
+        }
+
+    for (double &square : squares)
+      square = std::sqrt(Utilities::MPI::sum(square, mpi_communicator));
+    return {{{squares[0], squares[1]}}, {{squares[2], squares[3]}}, squares[4]};
+  }
+
+
+
+  template class ErrorNorms<2>;
+} // namespace membranes

@@ -1,0 +1,141 @@
+#include <algorithm>
+#include <deal.II/base/mpi.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/vector.h>
+#include <membranes/linear_solver.h>
+
+namespace membranes
+{
+  template <int dim>
+  LinearSolver<dim>::LinearSolver(const Parameters::LinearSolverType type,
+                                  const MPI_Comm mpi_communicator)
+    : type(type)
+    , mpi_communicator(mpi_communicator)
+    , use_direct(false)
+  {}
+
+
+
+  template <int dim>
+  void
+  LinearSolver<dim>::reinit(const DoFHandler<dim> &dof_handler)
+  {
+    const bool serial =
+      (Utilities::MPI::n_mpi_processes(mpi_communicator) == 1);
+    if (type == Parameters::LinearSolverType::direct && !serial)
+      throw Parameters::invalid_entry(
+        "Solver/Linear solver",
+        "direct",
+        "UMFPACK runs on one process: use cg-amg or auto under MPI");
+    use_direct = (type == Parameters::LinearSolverType::direct) ||
+                 (type == Parameters::LinearSolverType::automatic && serial &&
+                  dof_handler.n_dofs() <= direct_solver_dof_limit);
+    if (!use_direct)
+      DoFTools::extract_constant_modes(dof_handler,
+                                       ComponentMask(),
+                                       constant_modes);
+  }
+
+
+
+  template <int dim>
+  unsigned int
+  LinearSolver<dim>::solve(const MatrixType &matrix,
+                           VectorType       &x,
+                           const VectorType &rhs,
+                           const double      tolerance)
+  {
+    if (use_direct)
+      {
+        solve_direct(matrix, x, rhs);
+        return 0;
+      }
+    return solve_cg_amg(matrix, x, rhs, tolerance);
+  }
+
+
+
+  template <int dim>
+  std::string
+  LinearSolver<dim>::method() const
+  {
+    return use_direct ? "direct" : "cg-amg";
+  }
+
+
+
+  template <int dim>
+  void
+  LinearSolver<dim>::solve_direct(const MatrixType &matrix,
+                                  VectorType       &x,
+                                  const VectorType &rhs)
+  {
+    // UMFPACK factorizes deal.II's own SparseMatrix: copy the (serial)
+    // Trilinos matrix into one, row by row from Epetra's storage.
+    const Epetra_CrsMatrix       &epetra         = matrix.trilinos_matrix();
+    const types::global_dof_index n              = matrix.m();
+    const auto                    for_each_entry = [&](const auto &action) {
+      for (int row = 0; row < epetra.NumMyRows(); ++row)
+        {
+          int     n_entries;
+          double *values;
+          int    *columns;
+          epetra.ExtractMyRowView(row, n_entries, values, columns);
+          for (int k = 0; k < n_entries; ++k)
+            action(epetra.GRID(row), epetra.GCID(columns[k]), values[k]);
+        }
+    };
+    DynamicSparsityPattern pattern(n, n);
+    for_each_entry(
+      [&](const auto i, const auto j, const double) { pattern.add(i, j); });
+    SparsityPattern sparsity;
+    sparsity.copy_from(pattern);
+    SparseMatrix<double> copy(sparsity);
+    for_each_entry([&](const auto i, const auto j, const double value) {
+      copy.set(i, j, value);
+    });
+
+    SparseDirectUMFPACK umfpack;
+    umfpack.initialize(copy);
+    Vector<double> solution(rhs);
+    umfpack.solve(solution);
+    for (types::global_dof_index i = 0; i < n; ++i)
+      x[i] = solution[i];
+    x.compress(VectorOperation::insert);
+  }
+
+
+
+  template <int dim>
+  unsigned int
+  LinearSolver<dim>::solve_cg_amg(const MatrixType &matrix,
+                                  VectorType       &x,
+                                  const VectorType &rhs,
+                                  const double      tolerance)
+  {
+    const double rhs_norm = rhs.l2_norm();
+    if (rhs_norm == 0)
+      {
+        x = 0;
+        return 0;
+      }
+    TrilinosWrappers::PreconditionAMG                 amg;
+    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+    amg_data.elliptic        = true;
+    amg_data.constant_modes  = constant_modes;
+    amg_data.smoother_sweeps = 2;
+    amg.initialize(matrix, amg_data);
+
+    SolverControl        control(10000, std::max(tolerance, 1e-14 * rhs_norm));
+    SolverCG<VectorType> cg(control);
+    cg.solve(matrix, x, rhs, amg);
+    return control.last_step();
+  }
+
+
+
+  template class LinearSolver<2>;
+} // namespace membranes

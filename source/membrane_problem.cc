@@ -1,0 +1,320 @@
+#include <algorithm>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <filesystem>
+#include <limits>
+#include <membranes/membrane_problem.h>
+
+namespace membranes
+{
+  template <int dim>
+  MembraneProblem<dim>::MembraneProblem(const Parameters::All &parameters)
+    : parameters(parameters)
+    , mpi_communicator(MPI_COMM_WORLD)
+    , pcout(std::cout, Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
+    , data(parameters.problem, parameters.exact_solution)
+    , discretization(parameters.geometry.cell_type)
+    , dof_handler(triangulation)
+    , action(discretization, data)
+    , active_set_solver(parameters.solver,
+                        discretization,
+                        data,
+                        pcout,
+                        mpi_communicator)
+    , error_norms(discretization, data)
+    , report(parameters.output, pcout)
+    , field_output(parameters.output, discretization)
+  {}
+
+
+
+  /** The coarse mesh, and the check of the boundary data against it. */
+  template <int dim>
+  void
+  MembraneProblem<dim>::make_grid()
+  {
+    create_mesh(parameters.geometry, triangulation);
+    data.check_boundary_data(triangulation);
+  }
+
+
+
+  /**
+   * Created only once the scene has passed every check, so that a scene
+   * with bad data leaves nothing behind.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::create_output_directory() const
+  {
+    if (!pcout.is_active())
+      return;
+    std::error_code error;
+    std::filesystem::create_directories(parameters.output.directory, error);
+    if (error || !std::filesystem::is_directory(parameters.output.directory))
+      throw Parameters::invalid_entry("Output/Directory",
+                                      parameters.output.directory,
+                                      "cannot create this directory");
+  }
+
+
+
+  /**
+   * DoFs of (u1, u2), the index sets of the step-40 layout, the hanging node
+   * constraints, the vertices of the dual mesh and the solver's matrix.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::setup_system()
+  {
+    dof_handler.distribute_dofs(*discretization.fe);
+    locally_owned_dofs = dof_handler.locally_owned_dofs();
+    DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
+
+    hanging_node_constraints.clear();
+    hanging_node_constraints.reinit(locally_relevant_dofs);
+    DoFTools::make_hanging_node_constraints(dof_handler,
+                                            hanging_node_constraints);
+    hanging_node_constraints.close();
+
+    action.reinit(dof_handler,
+                  hanging_node_constraints,
+                  locally_owned_dofs,
+                  mpi_communicator);
+    active_set_solver.setup(dof_handler,
+                            locally_owned_dofs,
+                            locally_relevant_dofs,
+                            action);
+
+    solution.reinit(locally_owned_dofs, mpi_communicator);
+    ghosted_solution.reinit(locally_owned_dofs,
+                            locally_relevant_dofs,
+                            mpi_communicator);
+    lambda_h.reinit(locally_owned_dofs,
+                    locally_relevant_dofs,
+                    mpi_communicator);
+  }
+
+
+
+  /**
+   * Nested iteration: the solution and λ_h of the previous mesh,
+   * interpolated, are the initial guess, and give the initial active set.
+   * The first mesh starts from zero with no active vertex.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::transfer_solution()
+  {
+    if (!solution_transfer)
+      {
+        solution   = 0;
+        active_set = IndexSet(dof_handler.n_dofs());
+        return;
+      }
+
+    std::vector<VectorType> interpolated(2,
+                                         VectorType(locally_owned_dofs,
+                                                    mpi_communicator));
+    solution_transfer->interpolate(previous_mesh_vectors, interpolated);
+    solution_transfer.reset();
+    previous_mesh_vectors.clear();
+
+    solution         = interpolated[0];
+    ghosted_solution = interpolated[0];
+    lambda_h         = interpolated[1];
+    active_set =
+      active_set_solver.initial_active_set(action, ghosted_solution, lambda_h);
+  }
+
+
+
+  template <int dim>
+  void
+  MembraneProblem<dim>::solve()
+  {
+    const auto statistics =
+      active_set_solver.solve(action, solution, active_set);
+    ghosted_solution = solution;
+
+    record.active_set_iterations = statistics.iterations;
+    record.linear_iterations     = statistics.linear_iterations;
+    record.kkt_residual          = statistics.kkt_residual;
+    record.time_assembly         = statistics.assembly_time;
+    record.time_solve            = statistics.solve_time;
+    record.active_vertices =
+      Utilities::MPI::sum(active_set.n_elements(), mpi_communicator);
+  }
+
+
+
+  /**
+   * λ_h, the discrete identities of §4.1 measured on the solution, and the
+   * errors when the exact solution is known:
+   * - Prop. 12: the two formulas of (4.5) agree, max_a |λ_1a − λ_2a| d_a,
+   * - (4.8): λ_a (u1h − u2h)(a) = 0, max_a |λ_a d_a (u1h − u2h)(a)|,
+   * both relative to the data: forces by the force scale F of (4.5), and
+   * displacements by max |u_h|; and min_a λ_a, min_a (u1h − u2h)(a).
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::postprocess()
+  {
+    VectorType owned_lambda(locally_owned_dofs, mpi_communicator);
+    action.fill_nodal_vector(owned_lambda);
+    lambda_h = owned_lambda;
+
+    double      min_w      = std::numeric_limits<double>::max();
+    double      min_lambda = min_w, prop12 = 0, product = 0;
+    const auto &vertices = action.vertices();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        const auto  &a = vertices[k];
+        const double w =
+          ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]];
+        const double lambda = action.lambda(k);
+        min_w               = std::min(min_w, w);
+        min_lambda          = std::min(min_lambda, lambda);
+        prop12              = std::max(prop12,
+                          std::abs(action.lambda_from_membrane(0, k) -
+                                   action.lambda_from_membrane(1, k)) *
+                            a.dual_cell_measure);
+        product = std::max(product, std::abs(lambda * a.dual_cell_measure * w));
+      }
+    const double force_scale =
+      std::max(action.force_scale(), std::numeric_limits<double>::min());
+    const double u_scale = std::max(ghosted_solution.linfty_norm(),
+                                    std::numeric_limits<double>::min());
+    record.min_w         = Utilities::MPI::min(min_w, mpi_communicator);
+    record.min_lambda    = Utilities::MPI::min(min_lambda, mpi_communicator);
+    record.prop12_defect =
+      Utilities::MPI::max(prop12, mpi_communicator) / force_scale;
+    record.complementarity_defect =
+      Utilities::MPI::max(product, mpi_communicator) / (force_scale * u_scale);
+
+    if (data.exact_solution_known())
+      {
+        const auto errors    = error_norms.compute(dof_handler,
+                                                ghosted_solution,
+                                                lambda_h,
+                                                action.dual_mesh_vertices(),
+                                                mpi_communicator);
+        record.err_u1_H1     = errors.u_H1[0];
+        record.err_u2_H1     = errors.u_H1[1];
+        record.err_u1_L2     = errors.u_L2[0];
+        record.err_u2_L2     = errors.u_L2[1];
+        record.err_lambda_L2 = errors.lambda_L2;
+      }
+  }
+
+
+
+  /** u1, u2, u1 − u2, λ_h and the active set, if the scene asks for them. */
+  template <int dim>
+  void
+  MembraneProblem<dim>::output_results(const unsigned int cycle)
+  {
+    if (!parameters.output.write_vtu)
+      return;
+    VectorType contact_fields(locally_owned_dofs, mpi_communicator);
+    contact_fields = 0;
+    for (const auto &a : action.vertices())
+      {
+        contact_fields[a.dof[0]] = lambda_h[a.dof[0]];
+        contact_fields[a.dof[1]] = active_set.is_element(a.dof[0]) ? 1 : 0;
+      }
+    contact_fields.compress(VectorOperation::insert);
+    VectorType ghosted_fields(locally_owned_dofs,
+                              locally_relevant_dofs,
+                              mpi_communicator);
+    ghosted_fields = contact_fields;
+    field_output.write(cycle, dof_handler, ghosted_solution, ghosted_fields);
+  }
+
+
+
+  /**
+   * Global refinement; the solution and λ_h are handed to a
+   * SolutionTransfer first, to be interpolated onto the new mesh by
+   * transfer_solution().
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::refine_grid()
+  {
+    triangulation.set_all_refine_flags();
+    triangulation.prepare_coarsening_and_refinement();
+
+    previous_mesh_vectors = {ghosted_solution, lambda_h};
+    solution_transfer =
+      std::make_unique<SolutionTransfer<dim, VectorType>>(dof_handler);
+    solution_transfer->prepare_for_coarsening_and_refinement(
+      previous_mesh_vectors);
+    triangulation.execute_coarsening_and_refinement();
+  }
+
+
+
+  template <int dim>
+  void
+  MembraneProblem<dim>::run()
+  {
+    make_grid();
+    double cumulative_time = 0;
+    for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
+      {
+        record       = CycleRecord();
+        record.cycle = cycle;
+
+        Timer timer;
+        setup_system();
+        const auto max_dofs = parameters.refinement.max_dofs;
+        if (max_dofs > 0 && dof_handler.n_dofs() > max_dofs)
+          {
+            if (cycle == 0)
+              throw Parameters::invalid_entry(
+                "Refinement/Max dofs",
+                std::to_string(max_dofs),
+                "the first mesh already has " +
+                  std::to_string(dof_handler.n_dofs()) + " DoFs");
+            pcout << "Stopping: the next mesh would have "
+                  << dof_handler.n_dofs() << " DoFs > Max dofs = " << max_dofs
+                  << std::endl;
+            break;
+          }
+        if (cycle == 0)
+          create_output_directory();
+        transfer_solution();
+        record.time_setup = timer.wall_time();
+        record.cells      = triangulation.n_global_active_cells();
+        record.dofs       = dof_handler.n_dofs();
+        pcout << "Cycle " << cycle << ": " << record.cells << " cells, "
+              << record.dofs << " DoFs" << std::endl;
+
+        solve();
+
+        timer.restart();
+        postprocess();
+        record.time_postprocess = timer.wall_time();
+
+        record.wall_time = record.time_setup + record.time_assembly +
+                           record.time_solve + record.time_postprocess;
+        cumulative_time += record.wall_time;
+        record.cumulative_wall_time = cumulative_time;
+        pcout << "   " << record.active_set_iterations
+              << " active set iterations, " << record.active_vertices
+              << " active vertices, " << record.wall_time << " s" << std::endl;
+
+        report.add(record);
+        output_results(cycle);
+        if (cycle + 1 < parameters.refinement.cycles)
+          refine_grid();
+      }
+    report.print_convergence_table();
+  }
+
+
+
+  template class MembraneProblem<2>;
+} // namespace membranes

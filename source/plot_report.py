@@ -1,0 +1,274 @@
+#!/usr/bin/env python3
+"""Plot convergence histories from one or several membranes report.csv files.
+
+Usage::
+
+    plot_report.py [--output PREFIX] [--title T] [--svg]
+                   report.csv[=LABEL] [more.csv[=LABEL] ...]
+
+Draws one figure with two log-log panels: errors versus number of degrees of
+freedom (left) and errors versus cumulative wall time (right).  Every
+``err_*`` column that holds values is plotted, plus ``estimator`` when it is
+present and non-empty.  Each error quantity has its own colour, each report
+file its own marker and line style; a file is labelled by LABEL if given,
+otherwise by the name of the directory containing it.  The left panel also
+shows reference slopes N^{-1/2} ~ O(h) and N^{-1} ~ O(h^2) (two dimensions,
+so h ~ N^{-1/2}).
+
+The figure is written to PREFIX.png (and PREFIX.svg with ``--svg``); the
+default PREFIX is ``convergence`` in the directory of the first file.  The
+paths written are printed.  Rows or values that cannot be drawn on
+logarithmic axes (empty, zero, negative, NaN) are skipped.
+
+Requires matplotlib; the Agg backend is used, so no display is needed.
+"""
+
+import argparse
+import csv
+import math
+import os
+import sys
+
+PROG = "plot_report.py"
+DOFS = "dofs"
+TIME = "cumulative_wall_time_s"
+ERROR_PREFIX = "err_"
+ESTIMATOR = "estimator"
+
+MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<", ">", "*"]
+LINE_STYLES = ["-", "--", ":", "-."]
+# (exponent of N, legend label, dash pattern) of the reference slopes.
+REFERENCE_SLOPES = [(-0.5, r"$O(h)$", (0, (6, 3))),
+                    (-1.0, r"$O(h^2)$", (0, (2, 2)))]
+
+
+class PlotError(Exception):
+    """An input problem worth a one-line message."""
+
+
+class Series:
+    """The plottable contents of one report file."""
+
+    def __init__(self, path, label, columns):
+        self.path = path
+        self.label = label
+        self.columns = columns  # name -> list of floats (None when empty)
+
+    def quantities(self):
+        """The error columns (and estimator) that hold positive values."""
+        names = [name for name in self.columns
+                 if name.startswith(ERROR_PREFIX) or name == ESTIMATOR]
+        return [name for name in names if self.points(DOFS, name)]
+
+    def points(self, x_name, y_name):
+        """(x, y) pairs of two columns where both are positive and finite."""
+        if x_name not in self.columns or y_name not in self.columns:
+            return []
+        return [(x, y) for x, y in zip(self.columns[x_name],
+                                       self.columns[y_name])
+                if is_loggable(x) and is_loggable(y)]
+
+
+def is_loggable(value):
+    """Whether a value can be placed on a logarithmic axis."""
+    return value is not None and math.isfinite(value) and value > 0
+
+
+def to_float(text):
+    """A CSV field as float; None when empty or not a number."""
+    try:
+        return float(text) if text.strip() else None
+    except ValueError:
+        return None
+
+
+def split_argument(argument):
+    """Split 'path=LABEL' into (path, label); label None when absent."""
+    if os.path.exists(argument) or "=" not in argument:
+        return argument, None
+    path, _, label = argument.rpartition("=")
+    return path, label
+
+
+def default_label(path):
+    """The name of the directory containing the file."""
+    directory = os.path.dirname(os.path.abspath(path))
+    return os.path.basename(directory) or path
+
+
+def read_series(argument):
+    """Read one 'report.csv[=LABEL]' argument into a Series."""
+    path, label = split_argument(argument)
+    try:
+        with open(path, newline="", encoding="utf-8") as stream:
+            lines = [row for row in csv.reader(stream) if any(row)]
+    except OSError as error:
+        raise PlotError(f"cannot read {path}: {error.strerror}") from error
+    except (csv.Error, UnicodeDecodeError) as error:
+        raise PlotError(f"{path}: not a valid CSV file: {error}") from error
+    header = [name.strip() for name in lines[0]] if lines else []
+    if DOFS not in header or len(lines) < 2:
+        raise PlotError(f"{path}: no data rows with a '{DOFS}' column")
+    columns = {name: [to_float(row[index]) if index < len(row) else None
+                      for row in lines[1:]]
+               for index, name in enumerate(header)}
+    series = Series(path, label or default_label(path), columns)
+    if not series.quantities():
+        raise PlotError(f"{path}: no usable rows (no positive dofs together "
+                        "with a positive error or estimator value)")
+    return series
+
+
+def disambiguate_labels(series_list):
+    """Replace repeated labels by the file paths, so the legend is clear."""
+    labels = [series.label for series in series_list]
+    for series in series_list:
+        if labels.count(series.label) > 1:
+            series.label = series.path
+
+
+def quantity_order(series_list):
+    """All quantities over all files, err_* columns first, then estimator."""
+    found = []
+    for series in series_list:
+        found += [name for name in series.quantities() if name not in found]
+    return sorted(found, key=lambda name: (name == ESTIMATOR,
+                                           found.index(name)))
+
+
+def plot_panel(axes, series_list, colours, x_name, x_label):
+    """Draw every quantity of every file against one x column."""
+    for index, series in enumerate(series_list):
+        marker = MARKERS[index % len(MARKERS)]
+        style = LINE_STYLES[index % len(LINE_STYLES)]
+        for name, colour in colours.items():
+            points = series.points(x_name, name)
+            if points:
+                x, y = zip(*points)
+                axes.loglog(x, y, color=colour, marker=marker,
+                            linestyle=style, markersize=5)
+    axes.set_xlabel(x_label)
+    axes.set_ylabel("error")
+    axes.grid(True, which="both", alpha=0.3)
+
+
+def add_reference_slopes(axes, series_list, quantities):
+    """Dashed lines N^{-1/2} and N^{-1}, starting below the data."""
+    points = [point for series in series_list for name in quantities
+              for point in series.points(DOFS, name)]
+    if not points:
+        return []
+    n_min = min(x for x, _ in points)
+    n_max = max(x for x, _ in points)
+    if n_max <= n_min:
+        return []
+    y_start = 0.5 * min(y for x, y in points if x == n_min)
+    handles = []
+    for exponent, label, dashes in REFERENCE_SLOPES:
+        y_end = y_start * (n_max / n_min) ** exponent
+        (line,) = axes.loglog([n_min, n_max], [y_start, y_end], color="black",
+                              linestyle=dashes, linewidth=1, label=label)
+        handles.append(line)
+    return handles
+
+
+def legend_handles(series_list, colours):
+    """Proxy artists: one per quantity (colour), one per file (style)."""
+    from matplotlib.lines import Line2D
+
+    quantity_handles = [Line2D([], [], color=colour, label=name)
+                        for name, colour in colours.items()]
+    file_handles = [Line2D([], [], color="grey",
+                           marker=MARKERS[index % len(MARKERS)],
+                           linestyle=LINE_STYLES[index % len(LINE_STYLES)],
+                           label=series.label)
+                    for index, series in enumerate(series_list)]
+    return quantity_handles, file_handles
+
+
+def make_figure(series_list, title):
+    """Build the two-panel figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot
+
+    quantities = quantity_order(series_list)
+    palette = pyplot.rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = {name: palette[index % len(palette)]
+               for index, name in enumerate(quantities)}
+
+    figure, (left, right) = pyplot.subplots(1, 2, figsize=(13, 5.5))
+    plot_panel(left, series_list, colours, DOFS, "degrees of freedom N")
+    plot_panel(right, series_list, colours, TIME,
+               "cumulative wall time [s]")
+    slopes = add_reference_slopes(left, series_list, quantities)
+
+    quantity_handles, file_handles = legend_handles(series_list, colours)
+    left.legend(handles=quantity_handles + slopes, fontsize="small",
+                title="quantity")
+    right.legend(handles=file_handles, fontsize="small", title="report")
+    if title:
+        figure.suptitle(title)
+    figure.tight_layout()
+    return figure
+
+
+def output_prefix(requested, first_path):
+    """PREFIX from --output (a trailing .png/.svg is dropped) or default."""
+    if requested is None:
+        directory = os.path.dirname(os.path.abspath(first_path))
+        return os.path.join(directory, "convergence")
+    root, extension = os.path.splitext(requested)
+    return root if extension.lower() in (".png", ".svg") else requested
+
+
+def parse_arguments(argv):
+    """Parse the command line."""
+    parser = argparse.ArgumentParser(prog=PROG,
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("reports", nargs="+", metavar="report.csv[=LABEL]",
+                        help="report file, optionally with a legend label")
+    parser.add_argument("--output", metavar="PREFIX",
+                        help="write PREFIX.png (default: convergence.png "
+                             "beside the first report)")
+    parser.add_argument("--title", metavar="T", help="figure title")
+    parser.add_argument("--svg", action="store_true",
+                        help="also write PREFIX.svg")
+    return parser.parse_args(argv)
+
+
+def main(argv=None):
+    """Entry point; returns the exit status."""
+    arguments = parse_arguments(argv)
+    try:
+        series_list = [read_series(argument)
+                       for argument in arguments.reports]
+    except PlotError as error:
+        print(f"{PROG}: error: {error}", file=sys.stderr)
+        return 1
+    disambiguate_labels(series_list)
+    prefix = output_prefix(arguments.output, series_list[0].path)
+
+    try:
+        figure = make_figure(series_list, arguments.title)
+    except ImportError as error:
+        print(f"{PROG}: error: matplotlib is required ({error}); on Debian "
+              "install python3-matplotlib and run with /usr/bin/python3",
+              file=sys.stderr)
+        return 1
+    extensions = ["png", "svg"] if arguments.svg else ["png"]
+    for extension in extensions:
+        path = f"{prefix}.{extension}"
+        try:
+            figure.savefig(path, dpi=150)
+        except OSError as error:
+            print(f"{PROG}: error: cannot write {path}: {error.strerror}",
+                  file=sys.stderr)
+            return 1
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,182 @@
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <membranes/report.h>
+#include <sstream>
+
+namespace membranes
+{
+  namespace
+  {
+    /** The values of one row, in the order of Report::column_names(). */
+    std::vector<std::optional<double>>
+    row_values(const CycleRecord &r)
+    {
+      return {r.cycle,
+              r.cells,
+              static_cast<double>(r.dofs),
+              r.active_set_iterations,
+              r.active_vertices,
+              r.wall_time,
+              r.cumulative_wall_time,
+              r.err_u1_H1,
+              r.err_u2_H1,
+              r.err_u1_L2,
+              r.err_u2_L2,
+              r.err_lambda_L2,
+              r.estimator,
+              r.effectivity,
+              r.kkt_residual,
+              r.min_w,
+              r.min_lambda,
+              r.prop12_defect,
+              r.complementarity_defect,
+              r.linear_iterations,
+              r.time_setup,
+              r.time_assembly,
+              r.time_solve,
+              r.time_postprocess};
+    }
+
+    /** Columns that hold whole numbers. */
+    bool
+    is_count(const std::string &column)
+    {
+      return column == "cycle" || column == "cells" || column == "dofs" ||
+             column == "active_set_iterations" || column == "active_vertices" ||
+             column == "linear_iterations";
+    }
+  } // namespace
+
+
+
+  const std::vector<std::string> &
+  Report::column_names()
+  {
+    static const std::vector<std::string> names{"cycle",
+                                                "cells",
+                                                "dofs",
+                                                "active_set_iterations",
+                                                "active_vertices",
+                                                "wall_time_s",
+                                                "cumulative_wall_time_s",
+                                                "err_u1_H1",
+                                                "err_u2_H1",
+                                                "err_u1_L2",
+                                                "err_u2_L2",
+                                                "err_lambda_L2",
+                                                "estimator",
+                                                "effectivity",
+                                                "kkt_residual",
+                                                "min_w",
+                                                "min_lambda",
+                                                "prop12_defect",
+                                                "complementarity_defect",
+                                                "linear_iterations",
+                                                "time_setup_s",
+                                                "time_assembly_s",
+                                                "time_solve_s",
+                                                "time_postprocess_s"};
+    return names;
+  }
+
+
+
+  Report::Report(const Parameters::Output &parameters,
+                 const ConditionalOStream &pcout)
+    : parameters(parameters)
+    , pcout(pcout)
+  {}
+
+
+
+  void
+  Report::add(const CycleRecord &record)
+  {
+    records.push_back(record);
+    if (parameters.report && pcout.is_active())
+      write_csv();
+  }
+
+
+
+  void
+  Report::write_csv() const
+  {
+    const std::string file_name = parameters.directory + "/report.csv";
+    const std::string temporary = file_name + ".tmp";
+    {
+      std::ofstream out(temporary);
+      const auto   &names = column_names();
+      for (unsigned int c = 0; c < names.size(); ++c)
+        out << (c == 0 ? "" : ",") << names[c];
+      out << '\n' << std::setprecision(10);
+      for (const CycleRecord &record : records)
+        {
+          const auto values = row_values(record);
+          for (unsigned int c = 0; c < values.size(); ++c)
+            {
+              if (c > 0)
+                out << ',';
+              if (values[c])
+                out << *values[c];
+            }
+          out << '\n';
+        }
+      if (!out)
+        throw std::runtime_error("Output/Directory: cannot write " + temporary);
+    }
+    if (std::rename(temporary.c_str(), file_name.c_str()) != 0)
+      throw std::runtime_error("Output/Directory: cannot write " + file_name);
+  }
+
+
+
+  void
+  Report::print_convergence_table()
+  {
+    ConvergenceTable               table;
+    const auto                    &names = column_names();
+    const std::vector<std::string> shown{"cycle",
+                                         "cells",
+                                         "dofs",
+                                         "active_set_iterations",
+                                         "active_vertices",
+                                         "cumulative_wall_time_s",
+                                         "err_u1_H1",
+                                         "err_u2_H1",
+                                         "err_u1_L2",
+                                         "err_u2_L2",
+                                         "err_lambda_L2"};
+    for (const CycleRecord &record : records)
+      {
+        const auto values = row_values(record);
+        for (unsigned int c = 0; c < names.size(); ++c)
+          if (std::find(shown.begin(), shown.end(), names[c]) != shown.end() &&
+              values[c])
+            {
+              if (is_count(names[c]))
+                table.add_value(names[c],
+                                static_cast<unsigned long long>(*values[c]));
+              else
+                table.add_value(names[c], *values[c]);
+            }
+      }
+    for (const std::string &column : shown)
+      if (column.rfind("err_", 0) == 0 && records.front().err_u1_H1)
+        {
+          table.set_precision(column, 3);
+          table.set_scientific(column, true);
+          table.evaluate_convergence_rates(
+            column, "dofs", ConvergenceTable::reduction_rate_log2, 2);
+        }
+    table.set_precision("cumulative_wall_time_s", 2);
+    if (pcout.is_active())
+      {
+        pcout << std::endl;
+        table.write_text(pcout.get_stream(),
+                         TableHandler::TextOutputFormat::org_mode_table);
+      }
+  }
+} // namespace membranes
