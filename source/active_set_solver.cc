@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <membranes/active_set_solver.h>
+#include <membranes/cell_system.h>
 
 namespace membranes
 {
@@ -96,47 +97,14 @@ namespace membranes
     system_matrix = 0;
     system_rhs    = 0;
 
-    const FiniteElement<dim> &fe = *discretization.fe;
-    FEValues<dim>             fe_values(*discretization.mapping,
-                            fe,
-                            discretization.cell_quadrature,
-                            update_values | update_gradients |
-                              update_quadrature_points | update_JxW_values);
-    const unsigned int        dofs_per_cell = fe.n_dofs_per_cell();
-    FullMatrix<double>        cell_matrix(dofs_per_cell, dofs_per_cell);
-    Vector<double>            cell_rhs(dofs_per_cell);
-    std::vector<types::global_dof_index> local_dof_indices(dofs_per_cell);
-    std::array<std::vector<double>, 2>   loads;
-    for (auto &load : loads)
-      load.resize(fe_values.n_quadrature_points);
-
+    CellSystem<dim> cell_system(discretization, data);
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_values.reinit(cell);
-          for (unsigned int i = 0; i < 2; ++i)
-            data.load(i).value_list(fe_values.get_quadrature_points(),
-                                    loads[i]);
-          cell_matrix = 0;
-          cell_rhs    = 0;
-          // Σ_i μ_i ∫ ∇u_i·∇v_i = Σ_i ∫ f_i v_i: the two membranes do not
-          // couple here (both elements of the FESystem are primitive).
-          for (const unsigned int q : fe_values.quadrature_point_indices())
-            for (const unsigned int i : fe_values.dof_indices())
-              {
-                const unsigned int c = fe.system_to_component_index(i).first;
-                for (const unsigned int j : fe_values.dof_indices())
-                  if (fe.system_to_component_index(j).first == c)
-                    cell_matrix(i, j) +=
-                      data.mu[c] * fe_values.shape_grad(i, q) *
-                      fe_values.shape_grad(j, q) * fe_values.JxW(q);
-                cell_rhs(i) +=
-                  loads[c][q] * fe_values.shape_value(i, q) * fe_values.JxW(q);
-              }
-          cell->get_dof_indices(local_dof_indices);
-          constraints.distribute_local_to_global(cell_matrix,
-                                                 cell_rhs,
-                                                 local_dof_indices,
+          cell_system.reinit(cell);
+          constraints.distribute_local_to_global(cell_system.matrix,
+                                                 cell_system.rhs,
+                                                 cell_system.dof_indices,
                                                  system_matrix,
                                                  system_rhs);
         }

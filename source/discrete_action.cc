@@ -2,6 +2,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_values.h>
+#include <membranes/cell_system.h>
 #include <membranes/discrete_action.h>
 
 namespace membranes
@@ -31,52 +32,35 @@ namespace membranes
     this->mpi_communicator         = mpi_communicator;
 
     const FiniteElement<dim> &fe = *discretization.fe;
-    IndexSet                  boundary_dofs;
-    DoFTools::extract_boundary_dofs(dof_handler,
-                                    ComponentMask(),
-                                    boundary_dofs);
+    const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
 
     // d_a = ∫ φ_a as the row sums of the mass matrix, condensed with the
     // hanging node constraints, and the diagonal ∫ |∇φ_a|².
     VectorType dual_cell_measure(locally_owned_dofs, mpi_communicator);
     VectorType stiffness_diagonal(locally_owned_dofs, mpi_communicator);
 
-    FEValues<dim>                        fe_values(*discretization.mapping,
-                            fe,
-                            discretization.cell_quadrature,
-                            update_values | update_gradients |
-                              update_JxW_values);
-    const unsigned int                   dofs_per_cell = fe.n_dofs_per_cell();
-    std::vector<types::global_dof_index> local_dof_indices(dofs_per_cell);
-    Vector<double>                       local_measure(dofs_per_cell);
-    Vector<double>                       local_stiffness(dofs_per_cell);
+    CellSystem<dim>    cell_system(discretization, data);
+    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
+    Vector<double>     local_stiffness(dofs_per_cell);
     std::vector<std::array<types::global_dof_index, 2>> candidates;
 
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_values.reinit(cell);
-          cell->get_dof_indices(local_dof_indices);
-          local_measure   = 0;
-          local_stiffness = 0;
-          for (const unsigned int q : fe_values.quadrature_point_indices())
-            for (const unsigned int i : fe_values.dof_indices())
-              {
-                const unsigned int c = fe.system_to_component_index(i).first;
-                local_measure(i) +=
-                  fe_values.shape_value_component(i, q, c) * fe_values.JxW(q);
-                local_stiffness(i) +=
-                  fe_values.shape_grad_component(i, q, c).norm_square() *
-                  fe_values.JxW(q);
-              }
+          cell_system.reinit(cell);
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+            local_stiffness(i) =
+              cell_system.matrix(i, i) / data.mu[cell_system.membrane_of(i)];
           hanging_node_constraints.distribute_local_to_global(
-            local_measure, local_dof_indices, dual_cell_measure);
-          stiffness_diagonal.add(local_dof_indices, local_stiffness);
+            cell_system.lumped_mass,
+            cell_system.dof_indices,
+            dual_cell_measure);
+          stiffness_diagonal.add(cell_system.dof_indices, local_stiffness);
 
           for (const unsigned int v : cell->vertex_indices())
             candidates.push_back(
-              {{local_dof_indices[fe.component_to_system_index(0, v)],
-                local_dof_indices[fe.component_to_system_index(1, v)]}});
+              {{cell_system.dof_indices[fe.component_to_system_index(0, v)],
+                cell_system.dof_indices[fe.component_to_system_index(1, v)]}});
         }
     dual_cell_measure.compress(VectorOperation::add);
     stiffness_diagonal.compress(VectorOperation::add);
@@ -108,61 +92,26 @@ namespace membranes
   void
   DiscreteAction<dim>::compute(const VectorType &ghosted_solution)
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
     // The two terms of (4.5), assembled as vectors over all DoFs:
-    // stiffness_term_i = μ_i ∫ ∇u_ih·∇φ and load_term_i = ∫ f_i φ.
+    // stiffness_term = A U (μ_i ∫ ∇u_ih·∇φ) and load_term = F (∫ f_i φ).
     VectorType stiffness_term(locally_owned_dofs, mpi_communicator);
     VectorType load_term(locally_owned_dofs, mpi_communicator);
 
-    FEValues<dim>      fe_values(*discretization.mapping,
-                            fe,
-                            discretization.cell_quadrature,
-                            update_values | update_gradients |
-                              update_quadrature_points | update_JxW_values);
-    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
-    const unsigned int n_q_points    = fe_values.n_quadrature_points;
-    std::vector<types::global_dof_index>       local_dof_indices(dofs_per_cell);
-    Vector<double>                             local_stiffness(dofs_per_cell);
-    Vector<double>                             local_load(dofs_per_cell);
-    std::array<std::vector<Tensor<1, dim>>, 2> gradients;
-    std::array<std::vector<double>, 2>         loads;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        gradients[i].resize(n_q_points);
-        loads[i].resize(n_q_points);
-      }
-    const std::array<FEValuesExtractors::Scalar, 2> membrane{
-      {FEValuesExtractors::Scalar(0), FEValuesExtractors::Scalar(1)}};
-
+    CellSystem<dim>    cell_system(discretization, data);
+    const unsigned int dofs_per_cell = discretization.fe->n_dofs_per_cell();
+    Vector<double>     local_solution(dofs_per_cell);
+    Vector<double>     local_stiffness(dofs_per_cell);
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_values.reinit(cell);
-          cell->get_dof_indices(local_dof_indices);
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              fe_values[membrane[i]].get_function_gradients(ghosted_solution,
-                                                            gradients[i]);
-              data.load(i).value_list(fe_values.get_quadrature_points(),
-                                      loads[i]);
-            }
-          local_stiffness = 0;
-          local_load      = 0;
-          for (const unsigned int q : fe_values.quadrature_point_indices())
-            for (const unsigned int k : fe_values.dof_indices())
-              {
-                const unsigned int c = fe.system_to_component_index(k).first;
-                local_stiffness(k) += data.mu[c] * gradients[c][q] *
-                                      fe_values.shape_grad_component(k, q, c) *
-                                      fe_values.JxW(q);
-                local_load(k) += loads[c][q] *
-                                 fe_values.shape_value_component(k, q, c) *
-                                 fe_values.JxW(q);
-              }
+          cell_system.reinit(cell);
+          for (unsigned int i = 0; i < dofs_per_cell; ++i)
+            local_solution(i) = ghosted_solution[cell_system.dof_indices[i]];
+          cell_system.matrix.vmult(local_stiffness, local_solution);
           hanging_node_constraints->distribute_local_to_global(
-            local_stiffness, local_dof_indices, stiffness_term);
+            local_stiffness, cell_system.dof_indices, stiffness_term);
           hanging_node_constraints->distribute_local_to_global(
-            local_load, local_dof_indices, load_term);
+            cell_system.rhs, cell_system.dof_indices, load_term);
         }
     stiffness_term.compress(VectorOperation::add);
     load_term.compress(VectorOperation::add);

@@ -111,7 +111,7 @@ namespace membranes
       const auto   &names = column_names();
       for (unsigned int c = 0; c < names.size(); ++c)
         out << (c == 0 ? "" : ",") << names[c];
-      out << '\n' << std::setprecision(10);
+      out << '\n' << std::setprecision(12);
       for (const CycleRecord &record : records)
         {
           const auto values = row_values(record);

@@ -22,47 +22,18 @@ malformed file or an unknown column), 2 on a command-line error.
 """
 
 import argparse
-import csv
 import math
 import sys
+
+from check_report import ReportError, parse_number, read_csv
 
 PROG = "compare_reports.py"
 
 
-class ReportError(Exception):
-    """A report file is missing or malformed."""
-
-
 def read_report(path):
-    """Return the rows of a CSV file as dicts of stripped strings."""
-    try:
-        with open(path, newline="", encoding="utf-8") as stream:
-            lines = [row for row in csv.reader(stream) if any(row)]
-    except OSError as error:
-        raise ReportError(f"cannot read {path}: {error.strerror}") from error
-    except (csv.Error, UnicodeDecodeError) as error:
-        raise ReportError(f"{path}: not a valid CSV file: {error}") from error
-    if not lines:
-        raise ReportError(f"{path}: file is empty (no header)")
-    header = [name.strip() for name in lines[0]]
-    rows = []
-    for number, row in enumerate(lines[1:], start=2):
-        if len(row) != len(header):
-            raise ReportError(f"{path}: line {number} has {len(row)} fields, "
-                              f"the header has {len(header)}")
-        rows.append(dict(zip(header, (field.strip() for field in row))))
-    return header, rows
-
-
-def parse_number(text, path, column):
-    """Convert a field to float (None when empty)."""
-    if text == "":
-        return None
-    try:
-        return float(text)
-    except ValueError:
-        raise ReportError(f"{path}: column {column} holds a non-numeric "
-                          f"value {text!r}") from None
+    """Return (header, rows) of a CSV file, rows as dicts of strings."""
+    header, rows = read_csv(path)
+    return header, [dict(zip(header, row)) for row in rows]
 
 
 def fmt(value):
