@@ -148,7 +148,12 @@ namespace membranes
         // spherical manifold under refinement.
         if (geometry.domain == Parameters::Domain::disk)
           {
-            triangulation.set_all_manifold_ids_on_boundary(0);
+            // (Triangulation::set_all_manifold_ids_on_boundary() crashes on
+            // simplex meshes in deal.II 9.4: mark the coarse faces one by
+            // one.)
+            for (const auto &face : triangulation.active_face_iterators())
+              if (face->at_boundary())
+                face->set_manifold_id(0);
             triangulation.set_manifold(0, SphericalManifold<dim>());
           }
       }
