@@ -116,6 +116,10 @@ namespace membranes
     stiffness_term.compress(VectorOperation::add);
     load_term.compress(VectorOperation::add);
 
+    // The size of the terms that (4.5) balances at a: the stiffness term
+    // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
+    // μ_i ∫|∇φ_a|² |u_ih(a)|; on fine meshes it cancels down to O(h²) and
+    // its rounding error is relative to that diagonal part.
     double local_max = 0, local_sum_of_squares = 0;
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
       {
@@ -126,10 +130,13 @@ namespace membranes
             const double load      = load_term[a.dof[i]];
             const double sign      = (i == 0 ? 1. : -1.);
             lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
-            local_max =
-              std::max({local_max, std::abs(stiffness), std::abs(load)});
-            local_sum_of_squares +=
-              std::max(stiffness * stiffness, load * load);
+            const double size =
+              std::max({std::abs(stiffness),
+                        std::abs(load),
+                        data.mu[i] * a.stiffness_diagonal *
+                          std::abs(ghosted_solution[a.dof[i]])});
+            local_max = std::max(local_max, size);
+            local_sum_of_squares += size * size;
           }
       }
     max_force = Utilities::MPI::max(local_max, mpi_communicator);

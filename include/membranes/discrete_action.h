@@ -95,9 +95,12 @@ namespace membranes
     lambda(const unsigned int k) const;
 
     /**
-     * The size of the forces at the interior vertices, max over a and i of
-     * |μ_i ∫ ∇u_ih·∇φ_a| and |∫ f_i φ_a|: what residuals and λ_a d_a are
-     * measured against. Global over all processes.
+     * The size of the forces at the interior vertices: the max over a and
+     * i of the terms that (4.5) balances, |μ_i ∫ ∇u_ih·∇φ_a|, |∫ f_i φ_a|
+     * and the diagonal part μ_i ∫|∇φ_a|² |u_ih(a)| of the first (whose
+     * rounding error bounds how well the balance can be computed). What
+     * residuals and λ_a d_a are measured against; global over all
+     * processes. It scales like the data.
      */
     double
     force_scale() const;
