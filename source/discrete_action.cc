@@ -73,12 +73,12 @@ namespace membranes
     interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
     for (const auto &dofs : candidates)
       if (locally_owned_dofs.is_element(dofs[0]) &&
-          !boundary_dofs.is_element(dofs[0]) &&
-          !hanging_node_constraints.is_constrained(dofs[0]))
+          !boundary_dofs.is_element(dofs[0]))
         {
-          interior_vertices.push_back(
-            {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
           interior_vertex_dofs.add_index(dofs[0]);
+          if (!hanging_node_constraints.is_constrained(dofs[0]))
+            interior_vertices.push_back(
+              {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
         }
     interior_vertex_dofs.compress();
 

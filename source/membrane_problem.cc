@@ -2,6 +2,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/dofs/dof_tools.h>
+#include <deal.II/grid/grid_refinement.h>
 #include <filesystem>
 #include <limits>
 #include <membranes/membrane_problem.h>
@@ -23,6 +24,7 @@ namespace membranes
                         pcout,
                         mpi_communicator)
     , error_norms(discretization, data)
+    , error_estimator(discretization, data)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization)
   {}
@@ -121,6 +123,8 @@ namespace membranes
     solution_transfer.reset();
     previous_mesh_vectors.clear();
 
+    for (auto &vector : interpolated)
+      hanging_node_constraints.distribute(vector);
     solution         = interpolated[0];
     ghosted_solution = interpolated[0];
     lambda_h         = interpolated[1];
@@ -163,6 +167,7 @@ namespace membranes
   {
     VectorType owned_lambda(locally_owned_dofs, mpi_communicator);
     action.fill_nodal_vector(owned_lambda);
+    hanging_node_constraints.distribute(owned_lambda);
     lambda_h = owned_lambda;
 
     double      min_w      = std::numeric_limits<double>::max();
@@ -186,8 +191,15 @@ namespace membranes
       std::max(action.force_scale(), std::numeric_limits<double>::min());
     const double u_scale = std::max(ghosted_solution.linfty_norm(),
                                     std::numeric_limits<double>::min());
-    record.min_w         = Utilities::MPI::min(min_w, mpi_communicator);
-    record.min_lambda    = Utilities::MPI::min(min_lambda, mpi_communicator);
+    // The active set lives on V_h only: no hanging vertex is ever active.
+    unsigned int hanging_active = 0;
+    for (const auto dof : active_set)
+      if (hanging_node_constraints.is_constrained(dof))
+        ++hanging_active;
+    record.hanging_active_vertices =
+      Utilities::MPI::sum(hanging_active, mpi_communicator);
+    record.min_w      = Utilities::MPI::min(min_w, mpi_communicator);
+    record.min_lambda = Utilities::MPI::min(min_lambda, mpi_communicator);
     record.prop12_defect =
       Utilities::MPI::max(prop12, mpi_communicator) / force_scale;
     record.complementarity_defect =
@@ -205,7 +217,35 @@ namespace membranes
         record.err_u1_L2     = errors.u_L2[0];
         record.err_u2_L2     = errors.u_L2[1];
         record.err_lambda_L2 = errors.lambda_L2;
+        record.err_energy =
+          std::sqrt(data.mu[0] * errors.u_H1[0] * errors.u_H1[0] +
+                    data.mu[1] * errors.u_H1[1] * errors.u_H1[1]);
       }
+  }
+
+
+
+  /**
+   * The residual estimator η and its indicators η_K², when refinement is
+   * adaptive or the exact solution is known (then with the effectivity
+   * index η / |||e|||).
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::estimate_error()
+  {
+    if (parameters.refinement.strategy !=
+          Parameters::RefinementStrategy::adaptive &&
+        !data.exact_solution_known())
+      return;
+    record.estimator = error_estimator.estimate(dof_handler,
+                                                ghosted_solution,
+                                                lambda_h,
+                                                action.dual_mesh_vertices(),
+                                                indicators,
+                                                mpi_communicator);
+    if (record.err_energy)
+      record.effectivity = *record.estimator / *record.err_energy;
   }
 
 
@@ -235,15 +275,32 @@ namespace membranes
 
 
   /**
-   * Global refinement; the solution and λ_h are handed to a
-   * SolutionTransfer first, to be interpolated onto the new mesh by
-   * transfer_solution().
+   * Global refinement, or adaptive refinement by the estimator's η_K²:
+   * bulk (Dörfler) marking refines the fewest cells whose η_K² sum up to
+   * the share θ of η², fixed fraction the share θ of the cells with the
+   * largest η_K (coarsening likewise at the other end). The solution and
+   * λ_h are handed to a SolutionTransfer first, to be interpolated onto
+   * the new mesh by transfer_solution().
    */
   template <int dim>
   void
   MembraneProblem<dim>::refine_grid()
   {
-    triangulation.set_all_refine_flags();
+    const auto &refinement = parameters.refinement;
+    if (refinement.strategy == Parameters::RefinementStrategy::global)
+      triangulation.set_all_refine_flags();
+    else if (refinement.marking == Parameters::Marking::bulk)
+      GridRefinement::refine_and_coarsen_fixed_fraction(
+        triangulation,
+        indicators,
+        refinement.bulk_parameter,
+        refinement.coarsen_fraction);
+    else
+      GridRefinement::refine_and_coarsen_fixed_number(
+        triangulation,
+        indicators,
+        refinement.bulk_parameter,
+        refinement.coarsen_fraction);
     triangulation.prepare_coarsening_and_refinement();
 
     previous_mesh_vectors = {ghosted_solution, lambda_h};
@@ -298,8 +355,13 @@ namespace membranes
         postprocess();
         record.time_postprocess = timer.wall_time();
 
+        timer.restart();
+        estimate_error();
+        record.time_estimate = timer.wall_time();
+
         record.wall_time = record.time_setup + record.time_assembly +
-                           record.time_solve + record.time_postprocess;
+                           record.time_solve + record.time_postprocess +
+                           record.time_estimate;
         cumulative_time += record.wall_time;
         record.cumulative_wall_time = cumulative_time;
         pcout << "   " << record.active_set_iterations

@@ -207,7 +207,9 @@ namespace membranes::Parameters
     prm.declare_entry("Strategy",
                       "global",
                       Selection("global|adaptive"),
-                      "global: every cell is refined in every cycle.");
+                      "global: every cell is refined in every cycle; "
+                      "adaptive: cells are marked by the residual "
+                      "estimator.");
     prm.declare_entry("Cycles",
                       "6",
                       Integer(1, 100),
@@ -215,11 +217,21 @@ namespace membranes::Parameters
     prm.declare_entry("Marking",
                       "bulk",
                       Selection("bulk|fixed fraction"),
-                      "Marking for adaptive refinement.");
+                      "Marking for adaptive refinement: bulk (Doerfler) "
+                      "refines the fewest cells that hold the share 'Bulk "
+                      "parameter' of the squared estimator; fixed fraction "
+                      "refines that share of the cells, those with the "
+                      "largest indicators.");
     prm.declare_entry("Bulk parameter",
                       "0.5",
                       Double(0, 1),
-                      "Doerfler parameter of bulk marking.");
+                      "The share theta of the marking (0 < theta <= 1).");
+    prm.declare_entry("Coarsen fraction",
+                      "0",
+                      Double(0, 1),
+                      "The same share for coarsening, at the small end of "
+                      "the indicators; 0 = no coarsening (quadrilaterals "
+                      "only: deal.II 9.4 cannot coarsen triangles).");
     prm.declare_entry("Max dofs",
                       "0",
                       Integer(0),
@@ -229,7 +241,9 @@ namespace membranes::Parameters
                       "residual",
                       Selection("residual|flux"),
                       "A posteriori estimator that drives adaptive "
-                      "refinement.");
+                      "refinement. It is computed when Strategy = adaptive "
+                      "or when the exact solution is known (for the "
+                      "effectivity index).");
     prm.leave_subsection();
   }
 
@@ -237,18 +251,24 @@ namespace membranes::Parameters
   Refinement::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    if (prm.get("Strategy") == "adaptive")
-      throw invalid_entry("Refinement/Strategy",
-                          "adaptive",
-                          "only 'global' is available in this version");
-    strategy = RefinementStrategy::global;
-    cycles   = prm.get_integer("Cycles");
+    strategy =
+      (prm.get("Strategy") == "adaptive" ? RefinementStrategy::adaptive :
+                                           RefinementStrategy::global);
+    cycles = prm.get_integer("Cycles");
     marking =
       (prm.get("Marking") == "bulk" ? Marking::bulk : Marking::fixed_fraction);
     bulk_parameter = prm.get_double("Bulk parameter");
-    max_dofs       = prm.get_integer("Max dofs");
-    estimator =
-      (prm.get("Estimator") == "flux" ? Estimator::flux : Estimator::residual);
+    if (!(bulk_parameter > 0))
+      throw invalid_entry("Refinement/Bulk parameter",
+                          prm.get("Bulk parameter"),
+                          "the share must be in (0, 1]");
+    coarsen_fraction = prm.get_double("Coarsen fraction");
+    max_dofs         = prm.get_integer("Max dofs");
+    if (prm.get("Estimator") == "flux")
+      throw invalid_entry("Refinement/Estimator",
+                          "flux",
+                          "only 'residual' is available in this version");
+    estimator = Estimator::residual;
     prm.leave_subsection();
   }
 
@@ -318,5 +338,12 @@ namespace membranes::Parameters
     solver.parse_parameters(prm);
     refinement.parse_parameters(prm);
     output.parse_parameters(prm);
+    if (geometry.cell_type == CellType::triangle &&
+        refinement.strategy == RefinementStrategy::adaptive &&
+        refinement.coarsen_fraction > 0)
+      throw invalid_entry("Refinement/Coarsen fraction",
+                          std::to_string(refinement.coarsen_fraction),
+                          "deal.II 9.4 cannot coarsen triangle meshes: use 0 "
+                          "with 'Cell type = triangle'");
   }
 } // namespace membranes::Parameters

@@ -36,7 +36,10 @@ namespace membranes
               r.time_setup,
               r.time_assembly,
               r.time_solve,
-              r.time_postprocess};
+              r.time_postprocess,
+              r.err_energy,
+              r.time_estimate,
+              r.hanging_active_vertices};
     }
 
     /** Columns that hold whole numbers. */
@@ -45,7 +48,8 @@ namespace membranes
     {
       return column == "cycle" || column == "cells" || column == "dofs" ||
              column == "active_set_iterations" || column == "active_vertices" ||
-             column == "linear_iterations";
+             column == "linear_iterations" ||
+             column == "hanging_active_vertices";
     }
   } // namespace
 
@@ -77,7 +81,10 @@ namespace membranes
                                                 "time_setup_s",
                                                 "time_assembly_s",
                                                 "time_solve_s",
-                                                "time_postprocess_s"};
+                                                "time_postprocess_s",
+                                                "err_energy",
+                                                "time_estimate_s",
+                                                "hanging_active_vertices"};
     return names;
   }
 
@@ -148,7 +155,10 @@ namespace membranes
                                          "err_u2_H1",
                                          "err_u1_L2",
                                          "err_u2_L2",
-                                         "err_lambda_L2"};
+                                         "err_lambda_L2",
+                                         "err_energy",
+                                         "estimator",
+                                         "effectivity"};
     for (const CycleRecord &record : records)
       {
         const auto values = row_values(record);
@@ -163,6 +173,12 @@ namespace membranes
                 table.add_value(names[c], *values[c]);
             }
       }
+    for (const char *column : {"estimator", "effectivity"})
+      if (records.front().estimator)
+        {
+          table.set_precision(column, 3);
+          table.set_scientific(column, true);
+        }
     for (const std::string &column : shown)
       if (column.rfind("err_", 0) == 0 && records.front().err_u1_H1)
         {

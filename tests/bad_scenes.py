@@ -52,9 +52,17 @@ CASES = [
          "meshes", "square-triangles.msh"), [], ["Geometry/Cell type"]),
     ("unknown domain",
      "subsection Geometry\n  set Domain = torus\nend\n", [], ["Domain"]),
-    ("adaptive refinement (not available yet)",
-     "subsection Refinement\n  set Strategy = adaptive\nend\n", [],
-     ["Refinement/Strategy"]),
+    ("flux estimator (not available yet)",
+     "subsection Refinement\n  set Estimator = flux\nend\n", [],
+     ["Refinement/Estimator"]),
+    ("coarsening triangles",
+     "subsection Geometry\n  set Cell type = triangle\nend\n"
+     "subsection Refinement\n  set Strategy = adaptive\n"
+     "  set Coarsen fraction = 0.1\nend\n", [],
+     ["Refinement/Coarsen fraction"]),
+    ("Bulk parameter = 0",
+     "subsection Refinement\n  set Bulk parameter = 0\nend\n", [],
+     ["Refinement/Bulk parameter"]),
     ("Max dofs below the first mesh",
      "subsection Refinement\n  set Max dofs = 10\nend\n", [],
      ["Refinement/Max dofs"]),
@@ -107,7 +115,7 @@ def check_good_command_lines(membranes):
              "mu2", "Function constants", "f1", "f2", "g", "g2", "Known",
              "lambda", "Method", "Linear solver", "Tolerance",
              "Max active set iterations", "Strategy", "Cycles", "Marking",
-             "Bulk parameter", "Max dofs", "Estimator", "Directory", "Report",
+             "Bulk parameter", "Coarsen fraction", "Max dofs", "Estimator", "Directory", "Report",
              "Write vtu", "Flux reconstruction"]
     missing = [n for n in names if "set %s " % n not in printed.stdout]
     ok &= printed.returncode == 0 and not missing

@@ -16,6 +16,12 @@ Checks (COL is a column name from the header, VALUE a number):
     Observed convergence rate in h of COL over the last two rows,
     ``log(e_{k-1} / e_k) / log(sqrt(N_k / N_{k-1}))`` with N the ``dofs``
     column (two dimensions, so h ~ N^{-1/2}).
+``--dof-rate COL>=VALUE``
+    Observed rate in DoFs of COL, ``e ~ N^{-rate}``: the least-squares slope
+    of log(COL) against log(N) over the last half of the rows (at least
+    three), as adaptive meshes grow by irregular factors.
+``--band COL<=VALUE``
+    max/min of the non-empty values of COL (all positive) is <= VALUE.
 ``--max COL<=VALUE``
     Every non-empty value of COL is <= VALUE.
 ``--min COL>=VALUE``
@@ -171,6 +177,39 @@ def check_rate(report, arg):
     return rate >= bound, f"rate {rate:.4g}, bound >= {fmt(bound)} {detail}"
 
 
+def check_dof_rate(report, arg):
+    """Least-squares rate in DoFs of a column over the last half of the rows."""
+    column, bound = arg
+    count = max(3, (len(report.rows) + 1) // 2)
+    if len(report.rows) < count:
+        return False, f"needs at least {count} rows, the file has " \
+                      f"{len(report.rows)}"
+    pairs = list(zip(report.values(DOFS), report.values(column)))[-count:]
+    if any(n is None or e is None or n <= 0 or e <= 0 for n, e in pairs):
+        return False, f"rate undefined: empty or non-positive values {pairs}"
+    xs = [math.log(n) for n, _ in pairs]
+    ys = [math.log(e) for _, e in pairs]
+    mean_x, mean_y = sum(xs) / count, sum(ys) / count
+    spread = sum((x - mean_x) ** 2 for x in xs)
+    if spread == 0:
+        return False, "rate undefined: dofs do not change"
+    rate = -sum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys)) / spread
+    return rate >= bound, (f"rate in DoFs {rate:.4g} over the last {count} "
+                           f"rows (dofs {fmt(pairs[0][0])} -> "
+                           f"{fmt(pairs[-1][0])}), bound >= {fmt(bound)}")
+
+
+def check_band(report, arg):
+    """max/min of the non-empty (positive) values of a column."""
+    column, bound = arg
+    values = [v for v in report.values(column) if v is not None]
+    if not values or min(values) <= 0:
+        return False, f"needs positive values, got {values}"
+    ratio = max(values) / min(values)
+    return ratio <= bound, (f"max/min {ratio:.4g} (max {fmt(max(values))}, "
+                            f"min {fmt(min(values))}), bound <= {fmt(bound)}")
+
+
 def bound_check(values, bound, satisfied, relation):
     """Compare every non-empty value with a bound; list the violations."""
     present = [(row, value) for row, value in enumerate(values)
@@ -257,6 +296,10 @@ def check_decreasing(report, column):
 CHECKS = {
     "--rate": (check_rate, lambda s: split_bound(s, ">="),
                lambda a: f"{a[0]}>={fmt(a[1])}"),
+    "--dof-rate": (check_dof_rate, lambda s: split_bound(s, ">="),
+                   lambda a: f"{a[0]}>={fmt(a[1])}"),
+    "--band": (check_band, lambda s: split_bound(s, "<="),
+               lambda a: f"{a[0]}<={fmt(a[1])}"),
     "--max": (check_max, lambda s: split_bound(s, "<="),
               lambda a: f"{a[0]}<={fmt(a[1])}"),
     "--min": (check_min, lambda s: split_bound(s, ">="),
@@ -270,7 +313,8 @@ CHECKS = {
     "--decreasing": (check_decreasing, str, str),
 }
 
-METAVARS = {"--rate": "COL>=VALUE", "--max": "COL<=VALUE",
+METAVARS = {"--rate": "COL>=VALUE", "--dof-rate": "COL>=VALUE",
+            "--band": "COL<=VALUE", "--max": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
             "--empty": "COL", "--filled": "COL", "--rows": "N",
             "--decreasing": "COL"}
@@ -300,9 +344,9 @@ def parse_arguments(argv):
 
 def columns_of(option, argument):
     """The columns a check refers to."""
-    if option == "--rate":
+    if option in ("--rate", "--dof-rate"):
         return [argument[0], DOFS]
-    if option in ("--max", "--min", "--max-after-first"):
+    if option in ("--max", "--min", "--max-after-first", "--band"):
         return [argument[0]]
     if option == "--rows":
         return []

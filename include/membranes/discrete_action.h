@@ -74,7 +74,12 @@ namespace membranes
     const std::vector<Vertex> &
     vertices() const;
 
-    /** The u1 DoFs of the locally owned vertices of V_h. */
+    /**
+     * The u1 DoFs of the locally owned interior vertices: V_h and the
+     * hanging vertices, whose dual cells make up ω_h. On the pieces of a
+     * hanging vertex, λ_h is the constraint-weighted mean of the λ_a of its
+     * parents (AffineConstraints::distribute() of the nodal vector).
+     */
     const IndexSet &
     dual_mesh_vertices() const;
 

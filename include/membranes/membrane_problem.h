@@ -10,6 +10,7 @@
 #include <membranes/active_set_solver.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
+#include <membranes/error_estimator.h>
 #include <membranes/error_norms.h>
 #include <membranes/field_output.h>
 #include <membranes/parameters.h>
@@ -30,7 +31,8 @@ namespace membranes
    * run() is the whole story: for each cycle, set up DoFs and constraints,
    * transfer the previous solution and active set to the new mesh (nested
    * iteration), solve, postprocess (λ_h, the discrete identities, errors),
-   * add a row to the report, write fields, refine.
+   * estimate the error, add a row to the report, write fields, refine
+   * (globally, or by the estimator's indicators).
    *
    * Data layout is that of deal.II's step-40: locally owned and locally
    * relevant index sets, Trilinos vectors and matrices, ghosted vectors for
@@ -62,6 +64,8 @@ namespace membranes
     void
     postprocess();
     void
+    estimate_error();
+    void
     output_results(const unsigned int cycle);
     void
     refine_grid();
@@ -86,10 +90,13 @@ namespace membranes
     VectorType lambda_h;
     /** u1 DoFs of the active vertices. */
     IndexSet active_set;
+    /** η_K² of the a posteriori estimator, by active cell index. */
+    Vector<double> indicators;
 
     DiscreteAction<dim>  action;
     ActiveSetSolver<dim> active_set_solver;
     ErrorNorms<dim>      error_norms;
+    ErrorEstimator<dim>  error_estimator;
     Report               report;
     FieldOutput<dim>     field_output;
 

@@ -141,12 +141,13 @@ namespace membranes::Parameters
   /** Subsection `Refinement`: the sequence of meshes of one run. */
   struct Refinement
   {
-    RefinementStrategy strategy; ///< Global or adaptive refinement.
-    unsigned int       cycles;   ///< Number of meshes (cycles) of the run.
-    Marking            marking;  ///< Dörfler (bulk) or fixed fraction.
-    double             bulk_parameter; ///< Dörfler parameter θ in (0, 1].
-    unsigned int       max_dofs;       ///< Stop before exceeding; 0 = no limit.
-    Estimator          estimator; ///< Which a posteriori estimator drives it.
+    RefinementStrategy strategy;   ///< Global or adaptive refinement.
+    unsigned int       cycles;     ///< Number of meshes (cycles) of the run.
+    Marking            marking;    ///< Dörfler (bulk) or fixed fraction.
+    double       bulk_parameter;   ///< θ: share of η² (bulk) or of cells.
+    double       coarsen_fraction; ///< The same for coarsening; 0 = none.
+    unsigned int max_dofs;         ///< Stop before exceeding; 0 = no limit.
+    Estimator    estimator;        ///< Which a posteriori estimator drives it.
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -22,8 +22,9 @@ namespace membranes
    * manufactured solution written in terms of the tensions stays exact for
    * any μ1, μ2. Expressions are parsed and evaluated once on construction;
    * one that does not parse is an InputError naming its entry. Gradients of
-   * the exact solution (for H1 errors) come from fourth-order finite
-   * differences with step 1e-5, accurate to about 1e-11 for smooth data.
+   * the exact solution (for H1 errors) come from central (second-order)
+   * finite differences with step 1e-5, accurate to about 1e-10 for smooth
+   * data.
    */
   template <int dim>
   class ProblemData

@@ -22,17 +22,21 @@ namespace membranes
     unsigned int            active_set_iterations = 0;
     unsigned int            active_vertices       = 0;
     unsigned int            linear_iterations     = 0;
+    /** Active vertices that are hanging nodes (0: the active set is on V_h). */
+    unsigned int hanging_active_vertices = 0;
     /** Wall time of the cycle's solve phases (not of output writing). */
     double wall_time = 0;
     /** The same, summed over this and all previous cycles. */
     double cumulative_wall_time = 0;
     double time_setup = 0, time_assembly = 0, time_solve = 0,
-           time_postprocess = 0;
+           time_postprocess = 0, time_estimate = 0;
 
     /** Errors; empty when the exact solution is not known. */
     std::optional<double> err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2,
       err_lambda_L2;
-    /** A posteriori estimator and effectivity (adaptivity, not yet). */
+    /** Energy error (Σ_i μ_i |u_i − u_ih|²_{H1})^{1/2}; with the errors. */
+    std::optional<double> err_energy;
+    /** A posteriori estimator η and effectivity index η / err_energy. */
     std::optional<double> estimator, effectivity;
 
     /** Relative KKT residual of the active set solver at the end. */

@@ -1,0 +1,274 @@
+#include <array>
+#include <cmath>
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/fe/fe_interface_values.h>
+#include <deal.II/fe/fe_values.h>
+#include <membranes/error_estimator.h>
+
+namespace membranes
+{
+  template <int dim>
+  ErrorEstimator<dim>::ErrorEstimator(const Discretization<dim> &discretization,
+                                      const ProblemData<dim>    &data)
+    : discretization(discretization)
+    , data(data)
+    , dual_quadrature(discretization.fe->reference_cell(), 2)
+  {}
+
+
+
+  template <int dim>
+  double
+  ErrorEstimator<dim>::estimate(const DoFHandler<dim> &dof_handler,
+                                const VectorType      &ghosted_solution,
+                                const VectorType      &lambda_h,
+                                const IndexSet        &dual_mesh_vertices,
+                                Vector<double>        &indicators,
+                                const MPI_Comm         mpi_communicator) const
+  {
+    indicators.reinit(dof_handler.get_triangulation().n_active_cells());
+    add_cell_terms(
+      dof_handler, ghosted_solution, lambda_h, dual_mesh_vertices, indicators);
+    add_jump_terms(dof_handler, ghosted_solution, indicators);
+
+    double local_sum = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        local_sum += indicators[cell->active_cell_index()];
+      else
+        indicators[cell->active_cell_index()] = 0;
+    return std::sqrt(Utilities::MPI::sum(local_sum, mpi_communicator));
+  }
+
+
+
+  template <int dim>
+  void
+  ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
+                                      const VectorType      &ghosted_solution,
+                                      const VectorType      &lambda_h,
+                                      const IndexSet        &dual_mesh_vertices,
+                                      Vector<double>        &indicators) const
+  {
+    const FiniteElement<dim> &fe = *discretization.fe;
+    // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
+    // derivatives, Q1 ones do on non-affine cells.
+    const bool    with_laplacians = !fe.reference_cell().is_simplex();
+    FEValues<dim> fe_values(*discretization.mapping,
+                            fe,
+                            dual_quadrature.quadrature(),
+                            update_values | update_JxW_values |
+                              (with_laplacians ? update_hessians :
+                                                 update_default));
+    // The loads on the cell quadrature of the assembly, for f_ih and the
+    // oscillation.
+    FEValues<dim>      load_values(*discretization.mapping,
+                              fe,
+                              discretization.cell_quadrature,
+                              update_quadrature_points | update_JxW_values);
+    const unsigned int n_q_points = fe_values.n_quadrature_points;
+    std::vector<types::global_dof_index> local_dof_indices(
+      fe.n_dofs_per_cell());
+    std::array<std::vector<double>, 2> u, laplacian;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        u[i].resize(n_q_points);
+        laplacian[i].assign(n_q_points, 0.0);
+      }
+    std::vector<double>         lambda(n_q_points);
+    std::vector<double>         f(load_values.n_quadrature_points);
+    const std::array<double, 2> sign{{1., -1.}};
+
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          load_values.reinit(cell);
+          cell->get_dof_indices(local_dof_indices);
+          for (unsigned int q = 0; q < n_q_points; ++q)
+            {
+              const auto a = local_dof_indices[fe.component_to_system_index(
+                0, dual_quadrature.vertex_of_point(q))];
+              lambda[q] = dual_mesh_vertices.is_element(a) ? lambda_h[a] : 0.;
+            }
+
+          const double h_K     = cell->diameter();
+          double       eta2    = 0;
+          double       contact = 0;
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              const FEValuesExtractors::Scalar membrane(i);
+              fe_values[membrane].get_function_values(ghosted_solution, u[i]);
+              if (with_laplacians)
+                fe_values[membrane].get_function_laplacians(ghosted_solution,
+                                                            laplacian[i]);
+
+              data.load(i).value_list(load_values.get_quadrature_points(), f);
+              double measure = 0, f_mean = 0;
+              for (const unsigned int q :
+                   load_values.quadrature_point_indices())
+                {
+                  measure += load_values.JxW(q);
+                  f_mean += f[q] * load_values.JxW(q);
+                }
+              f_mean /= measure;
+              double oscillation = 0;
+              for (const unsigned int q :
+                   load_values.quadrature_point_indices())
+                oscillation += std::pow(f[q] - f_mean, 2) * load_values.JxW(q);
+
+              double residual = 0;
+              for (unsigned int q = 0; q < n_q_points; ++q)
+                residual += std::pow(f_mean + sign[i] * lambda[q] +
+                                       data.mu[i] * laplacian[i][q],
+                                     2) *
+                            fe_values.JxW(q);
+              eta2 += (h_K * h_K * residual +
+                       std::pow(h_K / numbers::PI, 2) * oscillation) /
+                      data.mu[i];
+            }
+          for (unsigned int q = 0; q < n_q_points; ++q)
+            contact += lambda[q] * (u[0][q] - u[1][q]) * fe_values.JxW(q);
+          indicators[cell->active_cell_index()] +=
+            eta2 + 2 * std::max(contact, 0.);
+        }
+  }
+
+
+
+  template <int dim>
+  void
+  ErrorEstimator<dim>::add_jump_terms(const DoFHandler<dim> &dof_handler,
+                                      const VectorType      &ghosted_solution,
+                                      Vector<double>        &indicators) const
+  {
+    const FiniteElement<dim>                       &fe = *discretization.fe;
+    const std::array<FEValuesExtractors::Scalar, 2> membrane{
+      {FEValuesExtractors::Scalar(0), FEValuesExtractors::Scalar(1)}};
+
+    // ∫_e |[μ_i ∂_n u_ih]|² for both membranes, on the edge that @p cell
+    // shares with its neighbour through face @p f.
+    std::function<std::array<double, 2>(
+      const typename DoFHandler<dim>::active_cell_iterator &,
+      const unsigned int)>
+      jump_integrals;
+
+    // Triangles: P1 gradients are constant on each cell.
+    std::vector<std::array<Tensor<1, dim>, 2>> cell_gradient;
+    // Quadrilaterals: the two traces on the edge, with matching points.
+    std::unique_ptr<FEInterfaceValues<dim>>                   interface_values;
+    std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
+
+    if (fe.reference_cell().is_simplex())
+      {
+        cell_gradient.resize(dof_handler.get_triangulation().n_active_cells());
+        FEValues<dim>               fe_values(*discretization.mapping,
+                                fe,
+                                QGaussSimplex<dim>(1),
+                                update_gradients);
+        std::vector<Tensor<1, dim>> gradient(1);
+        for (const auto &cell : dof_handler.active_cell_iterators())
+          if (!cell->is_artificial())
+            {
+              fe_values.reinit(cell);
+              for (unsigned int i = 0; i < 2; ++i)
+                {
+                  fe_values[membrane[i]].get_function_gradients(
+                    ghosted_solution, gradient);
+                  cell_gradient[cell->active_cell_index()][i] = gradient[0];
+                }
+            }
+        jump_integrals = [&](const auto &cell, const unsigned int f) {
+          const auto           face    = cell->face(f);
+          const Tensor<1, dim> tangent = face->vertex(1) - face->vertex(0);
+          Tensor<1, dim>       normal  = cross_product_2d(tangent);
+          const double         length  = tangent.norm();
+          normal /= length;
+          if (normal * (face->center() - cell->center()) < 0)
+            normal *= -1;
+          const auto           &neighbor = cell->neighbor(f);
+          std::array<double, 2> integrals;
+          for (unsigned int i = 0; i < 2; ++i)
+            integrals[i] =
+              std::pow(data.mu[i] *
+                         (cell_gradient[cell->active_cell_index()][i] -
+                          cell_gradient[neighbor->active_cell_index()][i]) *
+                         normal,
+                       2) *
+              length;
+          return integrals;
+        };
+      }
+    else
+      {
+        interface_values =
+          std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
+                                                   fe,
+                                                   QGauss<dim - 1>(2),
+                                                   update_gradients |
+                                                     update_JxW_values |
+                                                     update_normal_vectors);
+        jump_integrals = [&](const auto &cell, const unsigned int f) {
+          const auto &neighbor = cell->neighbor(f);
+          if (cell->neighbor_is_coarser(f))
+            {
+              const auto [nf, nsf] = cell->neighbor_of_coarser_neighbor(f);
+              interface_values->reinit(
+                cell, f, numbers::invalid_unsigned_int, neighbor, nf, nsf);
+            }
+          else
+            interface_values->reinit(cell,
+                                     f,
+                                     numbers::invalid_unsigned_int,
+                                     neighbor,
+                                     cell->neighbor_of_neighbor(f),
+                                     numbers::invalid_unsigned_int);
+          const unsigned int    n_q = interface_values->n_quadrature_points;
+          std::array<double, 2> integrals{};
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              for (unsigned int side = 0; side < 2; ++side)
+                {
+                  traces[i][side].resize(n_q);
+                  interface_values->get_fe_face_values(side)[membrane[i]]
+                    .get_function_gradients(ghosted_solution, traces[i][side]);
+                }
+              for (unsigned int q = 0; q < n_q; ++q)
+                integrals[i] +=
+                  std::pow(data.mu[i] * (traces[i][0][q] - traces[i][1][q]) *
+                             interface_values->normal(q),
+                           2) *
+                  interface_values->JxW(q);
+            }
+          return integrals;
+        };
+      }
+
+    // Every interior edge once, from its finer side (or from the cell with
+    // the smaller index between cells of the same level); half of the
+    // term goes to each of the two cells.
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for (const unsigned int f : cell->face_indices())
+          {
+            if (cell->at_boundary(f))
+              continue;
+            const auto &neighbor = cell->neighbor(f);
+            if (neighbor->has_children() ||
+                (!cell->neighbor_is_coarser(f) &&
+                 neighbor->active_cell_index() < cell->active_cell_index()))
+              continue;
+            const auto   integrals = jump_integrals(cell, f);
+            const double term =
+              0.5 * cell->face(f)->measure() *
+              (integrals[0] / data.mu[0] + integrals[1] / data.mu[1]);
+            indicators[cell->active_cell_index()] += term;
+            indicators[neighbor->active_cell_index()] += term;
+          }
+  }
+
+
+
+  template class ErrorEstimator<2>;
+} // namespace membranes
