@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
@@ -64,7 +65,8 @@ namespace membranes
   FieldOutput<dim>::write(const unsigned int     cycle,
                           const DoFHandler<dim> &dof_handler,
                           const VectorType      &ghosted_solution,
-                          const VectorType      &contact_fields)
+                          const VectorType      &contact_fields,
+                          const Vector<double>  *indicators)
   {
     const GapPostprocessor<dim> gap;
     DataOut<dim>                data_out;
@@ -75,6 +77,16 @@ namespace membranes
     data_out.add_data_vector(contact_fields,
                              std::vector<std::string>{"lambda_h",
                                                       "active_set"});
+    Vector<double> eta_K;
+    if (indicators)
+      {
+        eta_K = *indicators;
+        for (double &value : eta_K)
+          value = std::sqrt(value);
+        data_out.add_data_vector(eta_K,
+                                 "indicator",
+                                 DataOut<dim>::type_cell_data);
+      }
     data_out.build_patches(*discretization.mapping);
 
     const std::string name =

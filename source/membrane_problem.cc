@@ -269,7 +269,11 @@ namespace membranes
                               locally_relevant_dofs,
                               mpi_communicator);
     ghosted_fields = contact_fields;
-    field_output.write(cycle, dof_handler, ghosted_solution, ghosted_fields);
+    field_output.write(cycle,
+                       dof_handler,
+                       ghosted_solution,
+                       ghosted_fields,
+                       record.estimator ? &indicators : nullptr);
   }
 
 

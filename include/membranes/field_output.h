@@ -3,6 +3,7 @@
 
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/lac/vector.h>
 #include <membranes/discretization.h>
 #include <membranes/parameters.h>
 #include <string>
@@ -15,9 +16,10 @@ namespace membranes
 
   /**
    * Field output for ParaView (SPEC §3.4): one VTU file per cycle with u1,
-   * u2, w = u1 − u2, λ_h (the nodal values λ_a) and the active set
-   * indicator, and a .pvd file that lists the cycles. Each file is written
-   * to a temporary name and renamed, so that no half-written file is left.
+   * u2, w = u1 − u2, λ_h (the nodal values λ_a), the active set
+   * indicator and, when computed, the error indicator η_K, and a .pvd file that
+   * lists the cycles. Each file is written to a temporary name and renamed, so
+   * that no half-written file is left.
    */
   template <int dim>
   class FieldOutput
@@ -31,13 +33,15 @@ namespace membranes
     /**
      * Write cycle @p cycle. @p contact_fields has the layout of the solution
      * and holds λ_a in the u1 slot and the active set indicator (1 or 0) in
-     * the u2 slot of every vertex; all vectors are ghosted.
+     * the u2 slot of every vertex; all vectors are ghosted. The error
+     * indicators η_K (one per active cell) are written when given.
      */
     void
     write(const unsigned int     cycle,
           const DoFHandler<dim> &dof_handler,
           const VectorType      &ghosted_solution,
-          const VectorType      &contact_fields);
+          const VectorType      &contact_fields,
+          const Vector<double>  *indicators);
 
   private:
     const Parameters::Output                   &parameters;
