@@ -51,6 +51,7 @@ namespace membranes
         {
           fe_values.reinit(cell);
           cell->get_dof_indices(local_dof_indices);
+          data.set_gradient_step(1e-4 * cell->diameter());
           const auto &points = fe_values.get_quadrature_points();
           for (unsigned int i = 0; i < 2; ++i)
             {

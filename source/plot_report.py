@@ -3,13 +3,16 @@
 
 Usage::
 
-    plot_report.py [--output PREFIX] [--title T] [--svg]
+    plot_report.py [--output PREFIX] [--title T] [--svg] [--columns C1,C2,...]
                    report.csv[=LABEL] [more.csv[=LABEL] ...]
 
 Draws one figure with two log-log panels: errors versus number of degrees of
-freedom (left) and errors versus cumulative wall time (right).  Every
-``err_*`` column that holds values is plotted, plus ``estimator`` when it is
-present and non-empty.  Each error quantity has its own colour, each report
+freedom (left) and errors versus cumulative wall time (right).  By default
+every ``err_*`` column that holds values is plotted, plus ``estimator`` when
+it is present and non-empty; ``--columns`` names the columns to plot instead
+(e.g. ``--columns err_energy,estimator``), in the order given.  A named
+column must hold drawable values in at least one report, and every report in
+at least one named column.  Each quantity has its own colour, each report
 file its own marker and line style; a file is labelled by LABEL if given,
 otherwise by the name of the directory containing it.  The left panel also
 shows reference slopes N^{-1/2} ~ O(h) and N^{-1} ~ O(h^2) (two dimensions,
@@ -54,10 +57,14 @@ class Series:
         self.label = label
         self.columns = columns  # name -> list of floats (None when empty)
 
-    def quantities(self):
-        """The error columns (and estimator) that hold positive values."""
-        names = [name for name in self.columns
-                 if name.startswith(ERROR_PREFIX) or name == ESTIMATOR]
+    def quantities(self, selection=None):
+        """The columns to draw that hold positive values: @p selection if
+        given, else the error columns and the estimator."""
+        if selection is None:
+            names = [name for name in self.columns
+                     if name.startswith(ERROR_PREFIX) or name == ESTIMATOR]
+        else:
+            names = selection
         return [name for name in names if self.points(DOFS, name)]
 
     def points(self, x_name, y_name):
@@ -96,8 +103,10 @@ def default_label(path):
     return os.path.basename(directory) or path
 
 
-def read_series(argument):
-    """Read one 'report.csv[=LABEL]' argument into a Series."""
+def read_series(argument, selection=None):
+    """Read one 'report.csv[=LABEL]' argument into a Series; @p selection
+    is the list of --columns (checked by check_columns), None for the
+    default quantities."""
     path, label = split_argument(argument)
     try:
         with open(path, newline="", encoding="utf-8") as stream:
@@ -113,10 +122,45 @@ def read_series(argument):
                       for row in lines[1:]]
                for index, name in enumerate(header)}
     series = Series(path, label or default_label(path), columns)
-    if not series.quantities():
+    if selection is None and not series.quantities():
         raise PlotError(f"{path}: no usable rows (no positive dofs together "
                         "with a positive error or estimator value)")
     return series
+
+
+def parse_columns(text):
+    """The --columns value as a list of names, without repetitions."""
+    names = []
+    for name in (part.strip() for part in text.split(",")):
+        if name and name not in names:
+            names.append(name)
+    if not names:
+        raise PlotError("--columns: no column named")
+    for name in names:
+        if name in (DOFS, TIME):
+            raise PlotError(f"--columns: '{name}' is an axis, not a "
+                            "quantity")
+    return names
+
+
+def check_columns(series_list, selection):
+    """Every selected column must be drawable in at least one report, and
+    every report must have at least one selected column to draw."""
+    for name in selection:
+        if any(series.points(DOFS, name) for series in series_list):
+            continue
+        if not any(name in series.columns for series in series_list):
+            available = sorted({column for series in series_list
+                                for column in series.columns})
+            raise PlotError(f"--columns: no report has a column '{name}' "
+                            f"(columns: {','.join(available)})")
+        raise PlotError(f"--columns: column '{name}' has no positive value "
+                        "in any report")
+    for series in series_list:
+        if not series.quantities(selection):
+            raise PlotError(f"{series.path}: none of the columns "
+                            f"{','.join(selection)} has a positive value "
+                            "together with positive dofs")
 
 
 def disambiguate_labels(series_list):
@@ -127,8 +171,11 @@ def disambiguate_labels(series_list):
             series.label = series.path
 
 
-def quantity_order(series_list):
-    """All quantities over all files, err_* columns first, then estimator."""
+def quantity_order(series_list, selection=None):
+    """All quantities over all files, err_* columns first, then estimator;
+    the --columns @p selection as given, if any."""
+    if selection is not None:
+        return list(selection)
     found = []
     for series in series_list:
         found += [name for name in series.quantities() if name not in found]
@@ -186,14 +233,14 @@ def legend_handles(series_list, colours):
     return quantity_handles, file_handles
 
 
-def make_figure(series_list, title):
+def make_figure(series_list, title, selection=None):
     """Build the two-panel figure."""
     import matplotlib
 
     matplotlib.use("Agg")
     from matplotlib import pyplot
 
-    quantities = quantity_order(series_list)
+    quantities = quantity_order(series_list, selection)
     palette = pyplot.rcParams["axes.prop_cycle"].by_key()["color"]
     colours = {name: palette[index % len(palette)]
                for index, name in enumerate(quantities)}
@@ -235,6 +282,10 @@ def parse_arguments(argv):
     parser.add_argument("--title", metavar="T", help="figure title")
     parser.add_argument("--svg", action="store_true",
                         help="also write PREFIX.svg")
+    parser.add_argument("--columns", metavar="C1,C2,...",
+                        help="comma-separated report columns to plot, in "
+                             "this order (default: every err_* column with "
+                             "values, then estimator)")
     return parser.parse_args(argv)
 
 
@@ -242,8 +293,12 @@ def main(argv=None):
     """Entry point; returns the exit status."""
     arguments = parse_arguments(argv)
     try:
-        series_list = [read_series(argument)
+        selection = (parse_columns(arguments.columns)
+                     if arguments.columns is not None else None)
+        series_list = [read_series(argument, selection)
                        for argument in arguments.reports]
+        if selection is not None:
+            check_columns(series_list, selection)
     except PlotError as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 1
@@ -251,7 +306,7 @@ def main(argv=None):
     prefix = output_prefix(arguments.output, series_list[0].path)
 
     try:
-        figure = make_figure(series_list, arguments.title)
+        figure = make_figure(series_list, arguments.title, selection)
     except ImportError as error:
         print(f"{PROG}: error: matplotlib is required ({error}); on Debian "
               "install python3-matplotlib and run with /usr/bin/python3",

@@ -198,6 +198,17 @@ namespace membranes
 
 
   template <int dim>
+  void
+  ProblemData<dim>::set_gradient_step(const double step) const
+  {
+    for (const auto &u : exact_u)
+      if (u)
+        u->set_h(step);
+  }
+
+
+
+  template <int dim>
   bool
   ProblemData<dim>::exact_solution_known() const
   {

@@ -23,8 +23,7 @@ namespace membranes
    * any μ1, μ2. Expressions are parsed and evaluated once on construction;
    * one that does not parse is an InputError naming its entry. Gradients of
    * the exact solution (for H1 errors) come from central (second-order)
-   * finite differences with step 1e-5, accurate to about 1e-10 for smooth
-   * data.
+   * finite differences, with a step set by set_gradient_step().
    */
   template <int dim>
   class ProblemData
@@ -56,6 +55,16 @@ namespace membranes
 
     bool
     exact_solution_known() const;
+
+    /**
+     * Set the step of the finite differences that give the gradients of the
+     * exact displacements. The error norms set it relative to the cell they
+     * integrate over, so that the difference stencil never leaves the
+     * neighbourhood of the cell, however fine the mesh (near a re-entrant
+     * corner, a fixed step would reach across the corner).
+     */
+    void
+    set_gradient_step(const double step) const;
 
     /** Exact displacement u_i (i = 0 or 1); only when known. */
     const Function<dim> &
