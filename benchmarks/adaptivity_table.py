@@ -35,6 +35,8 @@ import csv
 import math
 import sys
 
+from solver_cost_table import fmt, number, print_table
+
 MAX_DOFS_RATIO = 1 / 10
 MAX_TIME_RATIO = 1 / 5
 MAX_ACTIVE_SET_ITERATIONS = 4
@@ -66,29 +68,6 @@ def read_report(path):
     if not rows:
         raise ReportError(f"{path}: no rows")
     return rows
-
-
-def number(row, column):
-    """The value of @p column in @p row, None where the field is empty."""
-    value = row.get(column, "")
-    return float(value) if value not in ("", None) else None
-
-
-def fmt(value, spec):
-    return "-" if value is None else format(value, spec)
-
-
-def print_table(header, rows):
-    """Markdown table, columns right aligned to their widest entry."""
-    widths = [max(len(str(r[i])) for r in [header] + rows) for i in range(len(header))]
-
-    def line(cells):
-        return "| " + " | ".join(str(c).rjust(w) for c, w in zip(cells, widths)) + " |"
-
-    print(line(header))
-    print("|" + "|".join("-" * (w + 1) + ":" for w in widths) + "|")
-    for row in rows:
-        print(line(row))
 
 
 def estimator_share(row):
