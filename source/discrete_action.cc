@@ -82,8 +82,12 @@ namespace membranes
         }
     interior_vertex_dofs.compress();
 
-    for (auto &lambda : lambda_i)
-      lambda.assign(interior_vertices.size(), 0.0);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        lambda_i[i].assign(interior_vertices.size(), 0.0);
+        stiffness_terms[i].assign(interior_vertices.size(), 0.0);
+        load_terms[i].assign(interior_vertices.size(), 0.0);
+      }
   }
 
 
@@ -130,6 +134,8 @@ namespace membranes
             const double load      = load_term[a.dof[i]];
             const double sign      = (i == 0 ? 1. : -1.);
             lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
+            stiffness_terms[i][k] = stiffness;
+            load_terms[i][k]      = load;
             const double size =
               std::max({std::abs(stiffness),
                         std::abs(load),
@@ -183,6 +189,26 @@ namespace membranes
                                             const unsigned int k) const
   {
     return lambda_i[i][k];
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::stiffness_term(const unsigned int i,
+                                      const unsigned int k) const
+  {
+    return stiffness_terms[i][k];
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::load_term(const unsigned int i,
+                                 const unsigned int k) const
+  {
+    return load_terms[i][k];
   }
 
 

@@ -13,23 +13,32 @@ namespace membranes
                                       const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
-    , dual_quadrature(discretization.fe->reference_cell(), 2)
   {}
 
 
 
   template <int dim>
   double
-  ErrorEstimator<dim>::estimate(const DoFHandler<dim> &dof_handler,
-                                const VectorType      &ghosted_solution,
-                                const VectorType      &lambda_h,
-                                const IndexSet        &dual_mesh_vertices,
-                                Vector<double>        &indicators,
-                                const MPI_Comm         mpi_communicator) const
+  ErrorEstimator<dim>::estimate(
+    const Parameters::Estimator    kind,
+    const DoFHandler<dim>         &dof_handler,
+    const VectorType              &ghosted_solution,
+    const FluxReconstruction<dim> &flux_reconstruction,
+    Vector<double>                &indicators,
+    const MPI_Comm                 mpi_communicator) const
   {
+    if (kind == Parameters::Estimator::flux)
+      return flux_estimate(dof_handler,
+                           ghosted_solution,
+                           flux_reconstruction,
+                           indicators,
+                           mpi_communicator);
+
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    add_cell_terms(
-      dof_handler, ghosted_solution, lambda_h, dual_mesh_vertices, indicators);
+    add_cell_terms(dof_handler,
+                   ghosted_solution,
+                   flux_reconstruction,
+                   indicators);
     add_jump_terms(dof_handler, ghosted_solution, indicators);
 
     double local_sum = 0;
@@ -45,11 +54,11 @@ namespace membranes
 
   template <int dim>
   void
-  ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
-                                      const VectorType      &ghosted_solution,
-                                      const VectorType      &lambda_h,
-                                      const IndexSet        &dual_mesh_vertices,
-                                      Vector<double>        &indicators) const
+  ErrorEstimator<dim>::add_cell_terms(
+    const DoFHandler<dim>         &dof_handler,
+    const VectorType              &ghosted_solution,
+    const FluxReconstruction<dim> &flux_reconstruction,
+    Vector<double>                &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
@@ -57,7 +66,7 @@ namespace membranes
     const bool    with_laplacians = !fe.reference_cell().is_simplex();
     FEValues<dim> fe_values(*discretization.mapping,
                             fe,
-                            dual_quadrature.quadrature(),
+                            flux_reconstruction.dual_quadrature().quadrature(),
                             update_values | update_JxW_values |
                               (with_laplacians ? update_hessians :
                                                  update_default));
@@ -68,8 +77,6 @@ namespace membranes
                               discretization.cell_quadrature,
                               update_quadrature_points | update_JxW_values);
     const unsigned int n_q_points = fe_values.n_quadrature_points;
-    std::vector<types::global_dof_index> local_dof_indices(
-      fe.n_dofs_per_cell());
     std::array<std::vector<double>, 2> u, laplacian;
     for (unsigned int i = 0; i < 2; ++i)
       {
@@ -85,13 +92,7 @@ namespace membranes
         {
           fe_values.reinit(cell);
           load_values.reinit(cell);
-          cell->get_dof_indices(local_dof_indices);
-          for (unsigned int q = 0; q < n_q_points; ++q)
-            {
-              const auto a = local_dof_indices[fe.component_to_system_index(
-                0, dual_quadrature.vertex_of_point(q))];
-              lambda[q] = dual_mesh_vertices.is_element(a) ? lambda_h[a] : 0.;
-            }
+          flux_reconstruction.lambda_h_values(cell, lambda);
 
           const double h_K     = cell->diameter();
           double       eta2    = 0;
@@ -266,6 +267,86 @@ namespace membranes
             indicators[cell->active_cell_index()] += term;
             indicators[neighbor->active_cell_index()] += term;
           }
+  }
+
+
+
+  template <int dim>
+  double
+  ErrorEstimator<dim>::flux_estimate(
+    const DoFHandler<dim>         &dof_handler,
+    const VectorType              &ghosted_solution,
+    const FluxReconstruction<dim> &flux_reconstruction,
+    Vector<double>                &indicators,
+    const MPI_Comm                 mpi_communicator) const
+  {
+    const auto &quadrature = flux_reconstruction.dual_quadrature().quadrature();
+    FEValues<dim>                      fe_values(*discretization.mapping,
+                            *discretization.fe,
+                            quadrature,
+                            update_values | update_gradients |
+                              update_jacobians | update_JxW_values);
+    const unsigned int                 n_q_points = quadrature.size();
+    std::array<std::vector<double>, 2> u;
+    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+    std::vector<Tensor<1, dim>>                flux;
+    std::vector<double>                        divergence, lambda;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        u[i].resize(n_q_points);
+        grad_u[i].resize(n_q_points);
+      }
+    const std::array<double, 2> sign{{1., -1.}};
+
+    indicators.reinit(dof_handler.get_triangulation().n_active_cells());
+    // Σ_K η_F,i,K², Σ_K η_R,i,K² and B = Σ_K (λ_h, w_h)⁺_K on this process.
+    std::array<double, 5> sums{};
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          flux_reconstruction.lambda_h_values(cell, lambda);
+          const double h_K  = cell->diameter();
+          double       eta2 = 0;
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              const FEValuesExtractors::Scalar membrane(i);
+              fe_values[membrane].get_function_values(ghosted_solution, u[i]);
+              fe_values[membrane].get_function_gradients(ghosted_solution,
+                                                         grad_u[i]);
+              flux_reconstruction.flux_values(
+                cell, i, fe_values, flux, divergence);
+              const auto load      = flux_reconstruction.load_values(cell, i);
+              double     flux_term = 0, residual = 0;
+              for (unsigned int q = 0; q < n_q_points; ++q)
+                {
+                  flux_term +=
+                    (data.mu[i] * grad_u[i][q] + flux[q]).norm_square() *
+                    fe_values.JxW(q);
+                  residual +=
+                    std::pow(load[q] + sign[i] * lambda[q] - divergence[q], 2) *
+                    fe_values.JxW(q);
+                }
+              flux_term /= data.mu[i];
+              residual *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
+              sums[2 * i] += flux_term;
+              sums[2 * i + 1] += residual;
+              eta2 += std::pow(std::sqrt(flux_term) + std::sqrt(residual), 2);
+            }
+          double contact = 0;
+          for (unsigned int q = 0; q < n_q_points; ++q)
+            contact += lambda[q] * (u[0][q] - u[1][q]) * fe_values.JxW(q);
+          contact = std::max(contact, 0.);
+          sums[4] += contact;
+          indicators[cell->active_cell_index()] = eta2 + 2 * contact;
+        }
+
+    for (double &sum : sums)
+      sum = Utilities::MPI::sum(sum, mpi_communicator);
+    double eta2 = 2 * sums[4];
+    for (unsigned int i = 0; i < 2; ++i)
+      eta2 += std::pow(std::sqrt(sums[2 * i]) + std::sqrt(sums[2 * i + 1]), 2);
+    return std::sqrt(eta2);
   }
 
 

@@ -10,32 +10,28 @@ namespace membranes
                               const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
-    , dual_quadrature(discretization.fe->reference_cell(), 2)
   {}
 
 
 
   template <int dim>
   typename ErrorNorms<dim>::Errors
-  ErrorNorms<dim>::compute(const DoFHandler<dim> &dof_handler,
-                           const VectorType      &ghosted_solution,
-                           const VectorType      &lambda_h,
-                           const IndexSet        &dual_mesh_vertices,
-                           const MPI_Comm         mpi_communicator) const
+  ErrorNorms<dim>::compute(const DoFHandler<dim>         &dof_handler,
+                           const VectorType              &ghosted_solution,
+                           const FluxReconstruction<dim> &flux_reconstruction,
+                           const MPI_Comm mpi_communicator) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     FEValues<dim>             fe_values(*discretization.mapping,
                             fe,
-                            dual_quadrature.quadrature(),
+                            flux_reconstruction.dual_quadrature().quadrature(),
                             update_values | update_gradients |
                               update_quadrature_points | update_JxW_values);
     const unsigned int        n_q_points = fe_values.n_quadrature_points;
-    std::vector<types::global_dof_index> local_dof_indices(
-      fe.n_dofs_per_cell());
-
     std::array<std::vector<double>, 2>         uh, u;
     std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
-    std::vector<double>                        lambda(n_q_points);
+    std::vector<double>                        lambda(n_q_points), lambda_h;
+    std::vector<bool>                          in_omega_h;
     for (unsigned int i = 0; i < 2; ++i)
       {
         uh[i].resize(n_q_points);
@@ -50,7 +46,7 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          cell->get_dof_indices(local_dof_indices);
+          flux_reconstruction.lambda_h_values(cell, lambda_h, &in_omega_h);
           data.set_gradient_step(1e-4 * cell->diameter());
           const auto &points = fe_values.get_quadrature_points();
           for (unsigned int i = 0; i < 2; ++i)
@@ -73,11 +69,8 @@ namespace membranes
                     (grad_u[i][q] - grad_uh[i][q]).norm_square() * JxW;
                   squares[2 + i] += std::pow(u[i][q] - uh[i][q], 2) * JxW;
                 }
-              const types::global_dof_index a =
-                local_dof_indices[fe.component_to_system_index(
-                  0, dual_quadrature.vertex_of_point(q))];
-              if (dual_mesh_vertices.is_element(a))
-                squares[4] += std::pow(lambda[q] - lambda_h[a], 2) * JxW;
+              if (in_omega_h[q])
+                squares[4] += std::pow(lambda[q] - lambda_h[q], 2) * JxW;
             }
         }
 

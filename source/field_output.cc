@@ -88,16 +88,49 @@ namespace membranes
                                  DataOut<dim>::type_cell_data);
       }
     data_out.build_patches(*discretization.mapping);
+    write_cycle(
+      cycle,
+      "solution",
+      [&](std::ostream &out) { data_out.write_vtu(out); },
+      cycles_written);
+  }
 
-    const std::string name =
-      "solution-" + Utilities::int_to_string(cycle, 2) + ".vtu";
-    write_atomically(parameters.directory + "/" + name,
-                     [&](std::ostream &out) { data_out.write_vtu(out); });
 
-    cycles_written.emplace_back(cycle, name);
-    write_atomically(parameters.directory + "/solution.pvd",
+
+  template <int dim>
+  void
+  FieldOutput<dim>::write_dual_mesh(
+    const unsigned int                               cycle,
+    const std::vector<DataOutBase::Patch<dim, dim>> &patches,
+    const std::vector<std::string>                  &names)
+  {
+    write_cycle(
+      cycle,
+      "dual-mesh",
+      [&](std::ostream &out) {
+        DataOutBase::write_vtu(
+          patches, names, {}, DataOutBase::VtkFlags(), out);
+      },
+      dual_mesh_cycles_written);
+  }
+
+
+
+  template <int dim>
+  void
+  FieldOutput<dim>::write_cycle(
+    const unsigned int                           cycle,
+    const std::string                           &name,
+    const std::function<void(std::ostream &)>   &writer,
+    std::vector<std::pair<double, std::string>> &written)
+  {
+    const std::string file_name =
+      name + "-" + Utilities::int_to_string(cycle, 2) + ".vtu";
+    write_atomically(parameters.directory + "/" + file_name, writer);
+    written.emplace_back(cycle, file_name);
+    write_atomically(parameters.directory + "/" + name + ".pvd",
                      [&](std::ostream &out) {
-                       DataOutBase::write_pvd_record(out, cycles_written);
+                       DataOutBase::write_pvd_record(out, written);
                      });
   }
 

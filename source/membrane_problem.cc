@@ -24,6 +24,7 @@ namespace membranes
                         pcout,
                         mpi_communicator)
     , error_norms(discretization, data)
+    , flux_reconstruction(discretization, data)
     , error_estimator(discretization, data)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization)
@@ -169,6 +170,9 @@ namespace membranes
     action.fill_nodal_vector(owned_lambda);
     hanging_node_constraints.distribute(owned_lambda);
     lambda_h = owned_lambda;
+    flux_reconstruction.set_lambda_h(dof_handler,
+                                     lambda_h,
+                                     action.dual_mesh_vertices());
 
     double      min_w      = std::numeric_limits<double>::max();
     double      min_lambda = min_w, prop12 = 0, product = 0;
@@ -209,8 +213,7 @@ namespace membranes
       {
         const auto errors    = error_norms.compute(dof_handler,
                                                 ghosted_solution,
-                                                lambda_h,
-                                                action.dual_mesh_vertices(),
+                                                flux_reconstruction,
                                                 mpi_communicator);
         record.err_u1_H1     = errors.u_H1[0];
         record.err_u2_H1     = errors.u_H1[1];
@@ -226,26 +229,73 @@ namespace membranes
 
 
   /**
-   * The residual estimator η and its indicators η_K², when refinement is
-   * adaptive or the exact solution is known (then with the effectivity
-   * index η / |||e|||).
+   * The fluxes t_ih of §4.2 and the defects of (4.17), (4.18) and of the
+   * balance of Lemma 17, if the scene asks for the flux reconstruction.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::reconstruct_fluxes()
+  {
+    if (!parameters.output.flux_reconstruction)
+      return;
+    Timer timer;
+    flux_reconstruction.reconstruct(ghosted_solution,
+                                    hanging_node_constraints,
+                                    action,
+                                    locally_owned_dofs,
+                                    mpi_communicator);
+    const auto &identities     = flux_reconstruction.identities();
+    record.measure_defect      = identities.measure_defect;
+    record.conservation_defect = identities.conservation_defect;
+    record.balance_defect      = identities.balance_defect;
+    record.time_flux           = timer.wall_time();
+  }
+
+
+
+  /**
+   * The residual estimator η and its indicators η_K², when it drives
+   * adaptive refinement or the exact solution is known, and the flux
+   * estimator with the flux reconstruction; with the exact solution, their
+   * effectivity indices η / |||e|||. The indicators of `Refinement/Estimator`
+   * are kept for marking. The time of the flux estimator counts as flux
+   * reconstruction time, the rest as estimator time.
    */
   template <int dim>
   void
   MembraneProblem<dim>::estimate_error()
   {
-    if (parameters.refinement.strategy !=
-          Parameters::RefinementStrategy::adaptive &&
-        !data.exact_solution_known())
-      return;
-    record.estimator = error_estimator.estimate(dof_handler,
-                                                ghosted_solution,
-                                                lambda_h,
-                                                action.dual_mesh_vertices(),
-                                                indicators,
-                                                mpi_communicator);
-    if (record.err_energy)
-      record.effectivity = *record.estimator / *record.err_energy;
+    const bool adaptive = parameters.refinement.strategy ==
+                          Parameters::RefinementStrategy::adaptive;
+    const auto driving = parameters.refinement.estimator;
+    indicators.reinit(0);
+    for (const auto kind :
+         {Parameters::Estimator::residual, Parameters::Estimator::flux})
+      {
+        const bool flux = (kind == Parameters::Estimator::flux);
+        if (flux ?
+              !parameters.output.flux_reconstruction :
+              !(adaptive && driving == kind) && !data.exact_solution_known())
+          continue;
+        Timer          timer;
+        Vector<double> kind_indicators;
+        const double   eta = error_estimator.estimate(kind,
+                                                    dof_handler,
+                                                    ghosted_solution,
+                                                    flux_reconstruction,
+                                                    kind_indicators,
+                                                    mpi_communicator);
+        (flux ? record.flux_estimator : record.estimator) = eta;
+        if (record.err_energy)
+          (flux ? record.flux_effectivity : record.effectivity) =
+            eta / *record.err_energy;
+        if (kind == driving)
+          indicators.swap(kind_indicators);
+        if (flux)
+          *record.time_flux += timer.wall_time();
+        else
+          record.time_estimate = timer.wall_time();
+      }
   }
 
 
@@ -273,7 +323,11 @@ namespace membranes
                        dof_handler,
                        ghosted_solution,
                        ghosted_fields,
-                       record.estimator ? &indicators : nullptr);
+                       indicators.size() ? &indicators : nullptr);
+    if (parameters.output.flux_reconstruction)
+      field_output.write_dual_mesh(cycle,
+                                   flux_reconstruction.patches(),
+                                   flux_reconstruction.data_names());
   }
 
 
@@ -359,13 +413,13 @@ namespace membranes
         postprocess();
         record.time_postprocess = timer.wall_time();
 
-        timer.restart();
+        reconstruct_fluxes();
         estimate_error();
-        record.time_estimate = timer.wall_time();
 
         record.wall_time = record.time_setup + record.time_assembly +
                            record.time_solve + record.time_postprocess +
-                           record.time_estimate;
+                           record.time_estimate +
+                           (record.time_flux ? *record.time_flux : 0.);
         cumulative_time += record.wall_time;
         record.cumulative_wall_time = cumulative_time;
         pcout << "   " << record.active_set_iterations

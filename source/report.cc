@@ -39,7 +39,13 @@ namespace membranes
               r.time_postprocess,
               r.err_energy,
               r.time_estimate,
-              r.hanging_active_vertices};
+              r.hanging_active_vertices,
+              r.flux_estimator,
+              r.flux_effectivity,
+              r.measure_defect,
+              r.conservation_defect,
+              r.balance_defect,
+              r.time_flux};
     }
 
     /** Columns that hold whole numbers. */
@@ -84,7 +90,13 @@ namespace membranes
                                                 "time_postprocess_s",
                                                 "err_energy",
                                                 "time_estimate_s",
-                                                "hanging_active_vertices"};
+                                                "hanging_active_vertices",
+                                                "flux_estimator",
+                                                "flux_effectivity",
+                                                "measure_defect",
+                                                "conservation_defect",
+                                                "balance_defect",
+                                                "time_flux_s"};
     return names;
   }
 
@@ -158,7 +170,9 @@ namespace membranes
                                          "err_lambda_L2",
                                          "err_energy",
                                          "estimator",
-                                         "effectivity"};
+                                         "effectivity",
+                                         "flux_estimator",
+                                         "flux_effectivity"};
     for (const CycleRecord &record : records)
       {
         const auto values = row_values(record);
@@ -173,8 +187,14 @@ namespace membranes
                 table.add_value(names[c], *values[c]);
             }
       }
-    for (const char *column : {"estimator", "effectivity"})
-      if (records.front().estimator)
+    for (const auto &[column, shown_in_table] :
+         {std::pair{"estimator", records.front().estimator.has_value()},
+          std::pair{"effectivity", records.front().effectivity.has_value()},
+          std::pair{"flux_estimator",
+                    records.front().flux_estimator.has_value()},
+          std::pair{"flux_effectivity",
+                    records.front().flux_effectivity.has_value()}})
+      if (shown_in_table)
         {
           table.set_precision(column, 3);
           table.set_scientific(column, true);

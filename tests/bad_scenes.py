@@ -52,7 +52,7 @@ CASES = [
          "meshes", "square-triangles.msh"), [], ["Geometry/Cell type"]),
     ("unknown domain",
      "subsection Geometry\n  set Domain = torus\nend\n", [], ["Domain"]),
-    ("flux estimator (not available yet)",
+    ("flux estimator without the flux reconstruction",
      "subsection Refinement\n  set Estimator = flux\nend\n", [],
      ["Refinement/Estimator"]),
     ("coarsening triangles",

@@ -28,6 +28,8 @@ Checks (COL is a column name from the header, VALUE a number):
     Every non-empty value of COL is >= VALUE.
 ``--max-after-first COL<=VALUE``
     As ``--max``, ignoring the first row.
+``--max-last COL<=VALUE``
+    As ``--max``, on the last row only (the finest mesh).
 ``--empty COL``
     Every value of COL is empty.
 ``--filled COL``
@@ -38,7 +40,7 @@ Checks (COL is a column name from the header, VALUE a number):
     The non-empty values of COL strictly decrease from row to row.
 
 Checks that look at non-empty values (``--max``, ``--min``,
-``--max-after-first``, ``--decreasing``) fail when there is nothing to look
+``--max-after-first``, ``--max-last``, ``--decreasing``) fail when there is nothing to look
 at, so that a quantity that was silently not computed does not pass.  NaN
 never satisfies a bound.
 
@@ -256,6 +258,16 @@ def check_max_after_first(report, arg):
                        lambda value, limit: value <= limit, "<=")
 
 
+def check_max_last(report, arg):
+    """The last row's value <= bound."""
+    column, bound = arg
+    values = report.values(column)
+    if not values:
+        return False, "no rows"
+    return bound_check([None] * (len(values) - 1) + values[-1:], bound,
+                       lambda value, limit: value <= limit, "<=")
+
+
 def check_empty(report, column):
     """Every value empty."""
     filled = [row for row, text in enumerate(report.raw(column)) if text]
@@ -307,6 +319,8 @@ CHECKS = {
     "--max-after-first": (check_max_after_first,
                           lambda s: split_bound(s, "<="),
                           lambda a: f"{a[0]}<={fmt(a[1])}"),
+    "--max-last": (check_max_last, lambda s: split_bound(s, "<="),
+                   lambda a: f"{a[0]}<={fmt(a[1])}"),
     "--empty": (check_empty, str, str),
     "--filled": (check_filled, str, str),
     "--rows": (check_rows, non_negative_int, str),
@@ -316,6 +330,7 @@ CHECKS = {
 METAVARS = {"--rate": "COL>=VALUE", "--dof-rate": "COL>=VALUE",
             "--band": "COL<=VALUE", "--max": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
+            "--max-last": "COL<=VALUE",
             "--empty": "COL", "--filled": "COL", "--rows": "N",
             "--decreasing": "COL"}
 
@@ -346,7 +361,8 @@ def columns_of(option, argument):
     """The columns a check refers to."""
     if option in ("--rate", "--dof-rate"):
         return [argument[0], DOFS]
-    if option in ("--max", "--min", "--max-after-first", "--band"):
+    if option in ("--max", "--min", "--max-after-first", "--max-last",
+                  "--band"):
         return [argument[0]]
     if option == "--rows":
         return []

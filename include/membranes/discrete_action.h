@@ -95,6 +95,17 @@ namespace membranes
     double
     lambda_from_membrane(const unsigned int i, const unsigned int k) const;
 
+    /**
+     * μ_i ∫ ∇u_ih·∇φ_a, the stiffness term of (4.5) of membrane @p i (0 or
+     * 1), for the k-th vertex of vertices().
+     */
+    double
+    stiffness_term(const unsigned int i, const unsigned int k) const;
+
+    /** ∫ f_i φ_a, the load term of (4.5), likewise (the assembly's). */
+    double
+    load_term(const unsigned int i, const unsigned int k) const;
+
     /** λ_a: the mean of the two formulas of (4.5) (they agree by Prop. 12). */
     double
     lambda(const unsigned int k) const;
@@ -126,6 +137,8 @@ namespace membranes
     std::vector<Vertex>                interior_vertices;
     IndexSet                           interior_vertex_dofs;
     std::array<std::vector<double>, 2> lambda_i;
+    std::array<std::vector<double>, 2> stiffness_terms;
+    std::array<std::vector<double>, 2> load_terms;
     double                             max_force;
     double                             l2_force;
   };

@@ -6,7 +6,8 @@
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
 #include <membranes/discretization.h>
-#include <membranes/dual_mesh.h>
+#include <membranes/flux_reconstruction.h>
+#include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 
 namespace membranes
@@ -14,8 +15,13 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * A residual a posteriori error indicator for the contact problem (SPEC
-   * §2.3), per cell K,
+   * The two a posteriori estimators of the contact problem, selected by
+   * `Refinement/Estimator`: both return η and the indicators η_K² that drive
+   * adaptive refinement, and η / |||e||| is reported as the effectivity
+   * index when the exact solution is known.
+   *
+   * <h3>The residual estimator</h3>
+   * Per cell K (SPEC §2.3),
    *
    *   η_K² = Σ_i μ_i⁻¹ [ h_K² ‖f_ih + s_i λ_h + μ_i Δu_ih‖²_K
    *                     + ½ Σ_{e ⊂ ∂K \ ∂ω} h_e ‖[μ_i ∂_n u_ih]‖²_e
@@ -24,8 +30,8 @@ namespace membranes
    *
    * with s_1 = +1, s_2 = −1 (the signs of λ in (1.1)), f_ih the mean of f_i
    * on K (4.14), λ_h piecewise constant on the dual cells (integrated over
-   * the pieces K ∩ D_a with the DualCellQuadrature; zero in the strip
-   * ω \ ω_h along the boundary), [·] the jump across interior edges (on
+   * the pieces K ∩ D_a with the FluxReconstruction's quadrature; zero in the
+   * strip ω \ ω_h along the boundary), [·] the jump across interior edges (on
    * edges with a hanging node, across each of the two small edges).
    *
    * The bracket is the classical residual estimator of the Poisson problem
@@ -47,6 +53,59 @@ namespace membranes
    * constant gradients) directly from the cell gradients, because deal.II
    * 9.4's FEInterfaceValues and KellyErrorEstimator fail on triangle meshes
    * with hanging nodes.
+   *
+   * <h3>The flux estimator</h3>
+   * Built on the flux reconstructions t_ih of
+   * §4.2 (in the spirit of Part 2 of the paper and of Dabaghi, Martin and
+   * Vohralík for this problem).
+   *
+   * Let e_i = u_i − u_ih, |||e|||² = Σ_i μ_i |e_i|²_{H1}, s_1 = +1,
+   * s_2 = −1, and σ_i ∈ H(div, ω) any flux. From −μ_i Δu_i = f_i + s_i λ,
+   *
+   *   Σ_i μ_i ‖∇e_i‖² = Σ_i [(f_i + s_i λ_h − div σ_i, e_i)
+   *                          − (μ_i ∇u_ih + σ_i, ∇e_i)]
+   *                     + (λ − λ_h, e_1 − e_2).
+   *
+   * With w = u1 − u2 ≥ 0, λ ≥ 0, λ w = 0, λ_h ≥ 0 and w_h = u1h − u2h ≥ 0
+   * (nodal values ≥ 0 give a nonnegative P1/Q1 function), the last term is
+   * (λ, −w_h) − (λ_h, w − w_h) ≤ (λ_h, w_h). The flux term is at most
+   * ‖μ_i^{1/2} ∇u_ih + μ_i^{-1/2} σ_i‖ · μ_i^{1/2}‖∇e_i‖. With
+   * A² = Σ_i (η_F,i + η_R,i)² and B = (λ_h, w_h), |||e|||² ≤ A |||e||| + B,
+   * hence
+   *
+   *   |||e||| ≤ η = (Σ_i (η_F,i + η_R,i)² + 2 B)^{1/2},
+   *   η_F,i = ‖μ_i^{1/2} ∇u_ih + μ_i^{-1/2} σ_ih‖,
+   *   η_R,i = (Σ_K (h_K/π)² μ_i^{-1} ‖f_i + s_i λ_h − div σ_ih‖²_K)^{1/2},
+   *
+   * provided the residual r_i = f_i + s_i λ_h − div σ_ih has mean value
+   * zero where the Poincaré inequality is applied.
+   *
+   * The flux t_ih of (4.13) has this property only on whole dual cells
+   * (Lemma 17, up to data oscillation): div t_ih varies from one
+   * sub-triangle of D_a to the next by O(|∇²u|), which would make η_R as
+   * large as η_F (measured: twice as large on case M). The estimator
+   * therefore uses σ_ih = t_ih + δ_ih, the equilibrated flux of
+   * FluxReconstruction: δ_ih lives in RT0 of the sub-triangles of D_a with
+   * zero normal flux on ∂D_a (so the fluxes (4.13) through ∂D_a, and with
+   * them (4.18) and the balance of Lemma 17, are those of t_ih) and makes
+   * ∫_κ div σ_ih = ∫_κ (f_i + s_i λ_h) + γ_a |κ| on every sub-triangle κ,
+   * with the constant γ_a that the compatibility on D_a requires (data
+   * oscillation, zero for loads that are constant on cells). Then r_i is
+   * f_i minus its means, of the order of h ∇f, and η_R is of higher order.
+   * On the dual cells of boundary vertices, which make up the strip
+   * ω \ ω_h and where e_i vanishes on ∂ω (Friedrichs instead of Poincaré),
+   * the same construction needs no γ. The 1/π of convex cells with the
+   * cell diameter h_K is used as the constant; η is an upper bound up to
+   * this choice of constant, the data oscillation γ_a and the
+   * interpolation of the boundary data g.
+   *
+   * For marking, per cell K,
+   *
+   *   η_K² = Σ_i μ_i^{-1} (‖μ_i ∇u_ih + σ_ih‖_K
+   *                        + (h_K/π) ‖f_i + s_i λ_h − div σ_ih‖_K)²
+   *          + 2 (λ_h, u1h − u2h)⁺_K,
+   *
+   * whose sum is at most η² (Minkowski).
    */
   template <int dim>
   class ErrorEstimator
@@ -59,26 +118,33 @@ namespace membranes
 
     /**
      * Fill @p indicators (indexed by active_cell_index(), zero on cells
-     * not locally owned) with η_K² and return η = (Σ_K η_K²)^{1/2} over
-     * all processes. @p lambda_h holds λ_h in the u1 slot of the vertices
-     * of @p dual_mesh_vertices (ghosted, like the solution).
+     * not locally owned) with the η_K² of estimator @p kind and return η
+     * over all processes, with the λ_h (and for the flux estimator the
+     * fluxes) of @p flux_reconstruction.
      */
     double
-    estimate(const DoFHandler<dim> &dof_handler,
-             const VectorType      &ghosted_solution,
-             const VectorType      &lambda_h,
-             const IndexSet        &dual_mesh_vertices,
-             Vector<double>        &indicators,
-             const MPI_Comm         mpi_communicator) const;
+    estimate(const Parameters::Estimator    kind,
+             const DoFHandler<dim>         &dof_handler,
+             const VectorType              &ghosted_solution,
+             const FluxReconstruction<dim> &flux_reconstruction,
+             Vector<double>                &indicators,
+             const MPI_Comm                 mpi_communicator) const;
 
   private:
+    /** The flux estimator: η_K² per cell, and η. */
+    double
+    flux_estimate(const DoFHandler<dim>         &dof_handler,
+                  const VectorType              &ghosted_solution,
+                  const FluxReconstruction<dim> &flux_reconstruction,
+                  Vector<double>                &indicators,
+                  const MPI_Comm                 mpi_communicator) const;
+
     /** Element residuals, oscillation and the contact term. */
     void
-    add_cell_terms(const DoFHandler<dim> &dof_handler,
-                   const VectorType      &ghosted_solution,
-                   const VectorType      &lambda_h,
-                   const IndexSet        &dual_mesh_vertices,
-                   Vector<double>        &indicators) const;
+    add_cell_terms(const DoFHandler<dim>         &dof_handler,
+                   const VectorType              &ghosted_solution,
+                   const FluxReconstruction<dim> &flux_reconstruction,
+                   Vector<double>                &indicators) const;
 
     /** ½ h_e μ_i⁻¹ ‖[μ_i ∂_n u_ih]‖²_e on both cells of every interior edge. */
     void
@@ -86,9 +152,8 @@ namespace membranes
                    const VectorType      &ghosted_solution,
                    Vector<double>        &indicators) const;
 
-    const Discretization<dim>    &discretization;
-    const ProblemData<dim>       &data;
-    const DualCellQuadrature<dim> dual_quadrature;
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
   };
 } // namespace membranes
 

@@ -6,7 +6,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
-#include <membranes/dual_mesh.h>
+#include <membranes/flux_reconstruction.h>
 #include <membranes/problem_data.h>
 
 namespace membranes
@@ -19,9 +19,10 @@ namespace membranes
    * ‖λ − λ_h‖_{L2(ω_h)}, where λ_h is piecewise constant on the dual cells
    * D_a and ω_h is their union (ω minus a strip along ∂ω).
    *
-   * All integrals use the DualCellQuadrature, so that each quadrature point
-   * knows the dual cell D_a it lies in and λ_h is evaluated exactly; the
-   * same rule integrates the displacement errors over the whole cell.
+   * All integrals use the DualCellQuadrature of the FluxReconstruction, so
+   * that each quadrature point knows the dual cell D_a it lies in and λ_h
+   * is evaluated exactly; the same rule integrates the displacement errors
+   * over the whole cell.
    */
   template <int dim>
   class ErrorNorms
@@ -39,21 +40,16 @@ namespace membranes
     ErrorNorms(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /**
-     * @p lambda_h holds λ_a in the u1 slot of each vertex a of V_h, whose u1
-     * DoFs are @p dual_mesh_vertices; both vectors are ghosted.
-     */
+    /** λ_h is the one of @p flux_reconstruction. */
     Errors
-    compute(const DoFHandler<dim> &dof_handler,
-            const VectorType      &ghosted_solution,
-            const VectorType      &lambda_h,
-            const IndexSet        &dual_mesh_vertices,
-            const MPI_Comm         mpi_communicator) const;
+    compute(const DoFHandler<dim>         &dof_handler,
+            const VectorType              &ghosted_solution,
+            const FluxReconstruction<dim> &flux_reconstruction,
+            const MPI_Comm                 mpi_communicator) const;
 
   private:
-    const Discretization<dim>    &discretization;
-    const ProblemData<dim>       &data;
-    const DualCellQuadrature<dim> dual_quadrature;
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
   };
 } // namespace membranes
 

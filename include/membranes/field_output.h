@@ -1,9 +1,11 @@
 #ifndef membranes_field_output_h
 #define membranes_field_output_h
 
+#include <deal.II/base/data_out_base.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
+#include <functional>
 #include <membranes/discretization.h>
 #include <membranes/parameters.h>
 #include <string>
@@ -43,10 +45,28 @@ namespace membranes
           const VectorType      &contact_fields,
           const Vector<double>  *indicators);
 
+    /**
+     * Write the sub-mesh S_h of the dual mesh of cycle @p cycle as
+     * dual-mesh-NN.vtu, one triangle per patch with the data @p names (see
+     * FluxReconstruction::patches()), and a dual-mesh.pvd over cycles.
+     */
+    void
+    write_dual_mesh(const unsigned int                               cycle,
+                    const std::vector<DataOutBase::Patch<dim, dim>> &patches,
+                    const std::vector<std::string>                  &names);
+
   private:
+    /** Write @p name of cycle @p cycle with @p writer, and its .pvd file. */
+    void
+    write_cycle(const unsigned int                           cycle,
+                const std::string                           &name,
+                const std::function<void(std::ostream &)>   &writer,
+                std::vector<std::pair<double, std::string>> &written);
+
     const Parameters::Output                   &parameters;
     const Discretization<dim>                  &discretization;
     std::vector<std::pair<double, std::string>> cycles_written;
+    std::vector<std::pair<double, std::string>> dual_mesh_cycles_written;
   };
 } // namespace membranes
 

@@ -13,6 +13,7 @@
 #include <membranes/error_estimator.h>
 #include <membranes/error_norms.h>
 #include <membranes/field_output.h>
+#include <membranes/flux_reconstruction.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <membranes/report.h>
@@ -31,8 +32,9 @@ namespace membranes
    * run() is the whole story: for each cycle, set up DoFs and constraints,
    * transfer the previous solution and active set to the new mesh (nested
    * iteration), solve, postprocess (λ_h, the discrete identities, errors),
-   * estimate the error, add a row to the report, write fields, refine
-   * (globally, or by the estimator's indicators).
+   * reconstruct the fluxes t_ih (if the scene asks for them), estimate the
+   * error, add a row to the report, write fields, refine (globally, or by
+   * the estimator's indicators).
    *
    * Data layout is that of deal.II's step-40: locally owned and locally
    * relevant index sets, Trilinos vectors and matrices, ghosted vectors for
@@ -64,6 +66,8 @@ namespace membranes
     void
     postprocess();
     void
+    reconstruct_fluxes();
+    void
     estimate_error();
     void
     output_results(const unsigned int cycle);
@@ -90,15 +94,16 @@ namespace membranes
     VectorType lambda_h;
     /** u1 DoFs of the active vertices. */
     IndexSet active_set;
-    /** η_K² of the a posteriori estimator, by active cell index. */
+    /** η_K² of the estimator that drives refinement, by active cell index. */
     Vector<double> indicators;
 
-    DiscreteAction<dim>  action;
-    ActiveSetSolver<dim> active_set_solver;
-    ErrorNorms<dim>      error_norms;
-    ErrorEstimator<dim>  error_estimator;
-    Report               report;
-    FieldOutput<dim>     field_output;
+    DiscreteAction<dim>     action;
+    ActiveSetSolver<dim>    active_set_solver;
+    ErrorNorms<dim>         error_norms;
+    FluxReconstruction<dim> flux_reconstruction;
+    ErrorEstimator<dim>     error_estimator;
+    Report                  report;
+    FieldOutput<dim>        field_output;
 
     /** Carries (u_h, λ_h) from one mesh to the next. */
     std::unique_ptr<SolutionTransfer<dim, VectorType>> solution_transfer;

@@ -30,6 +30,8 @@ namespace membranes
     double cumulative_wall_time = 0;
     double time_setup = 0, time_assembly = 0, time_solve = 0,
            time_postprocess = 0, time_estimate = 0;
+    /** Flux reconstruction and flux estimator; empty when not computed. */
+    std::optional<double> time_flux;
 
     /** Errors; empty when the exact solution is not known. */
     std::optional<double> err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2,
@@ -38,6 +40,13 @@ namespace membranes
     std::optional<double> err_energy;
     /** A posteriori estimator η and effectivity index η / err_energy. */
     std::optional<double> estimator, effectivity;
+    /** The flux estimator and its effectivity, with the flux reconstruction. */
+    std::optional<double> flux_estimator, flux_effectivity;
+    /**
+     * Defects of (4.17), (4.18) and of the balance of Lemma 17 (see
+     * FluxReconstruction::Identities), with the flux reconstruction.
+     */
+    std::optional<double> measure_defect, conservation_defect, balance_defect;
 
     /** Relative KKT residual of the active set solver at the end. */
     double kkt_residual = 0;

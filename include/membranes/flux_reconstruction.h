@@ -1,0 +1,351 @@
+#ifndef membranes_flux_reconstruction_h
+#define membranes_flux_reconstruction_h
+
+#include <array>
+#include <deal.II/base/array_view.h>
+#include <deal.II/base/data_out_base.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/base/quadrature.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/reference_cell.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discrete_action.h>
+#include <membranes/discretization.h>
+#include <membranes/problem_data.h>
+#include <string>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The dual mesh of §4.2 of the paper on one reference cell, and a
+   * quadrature on its pieces.
+   *
+   * For a vertex a of K, K ∩ D_a is the quadrilateral with corners a, the
+   * midpoints m_e of the two edges of K through a, and the barycentre b_K
+   * of K (the vertex average on quadrilaterals). It is the union of the two
+   * triangles κ = (a, m_e, b_K), the cells of the paper's sub-mesh S_h: one
+   * for every edge e of K and every end a of e. This class holds these
+   * reference sub-triangles and a QGaussSimplex rule mapped onto each of
+   * them, with the sub-triangle (and so the vertex a) of every point.
+   * FEValues maps the rule to the physical cell: for triangles the pieces
+   * map to the physical pieces exactly (affine map); for quadrilaterals the
+   * bilinear map sends the edges a–m_e and m_e–b_K to straight segments, so
+   * the union of the two mapped sub-triangles is again exactly K ∩ D_a (the
+   * edge a–b_K between them is mapped to a curve).
+   *
+   * With it, a function that is constant on dual cells (λ_h) is integrated
+   * against smooth ones without building the dual mesh explicitly: the rule
+   * is exact on each sub-triangle for polynomials of the given degree in
+   * reference coordinates.
+   */
+  template <int dim>
+  class DualCellQuadrature
+  {
+  public:
+    /**
+     * A reference sub-triangle κ = (a, m_e, b_K). Its corners are listed in
+     * this order; edge j is the one opposite corner j, so that edge 0
+     * (m_e–b_K) lies on ∂D_a, edge 1 (a–b_K) inside D_a, both inside K,
+     * and edge 2 (a–m_e) is half of the edge e of K.
+     */
+    struct SubTriangle
+    {
+      unsigned int                  vertex; ///< a, a vertex index of the cell
+      unsigned int                  face;   ///< e, a face index of the cell
+      std::array<Point<dim>, 3>     corners;
+      double                        area;    ///< Area in reference coordinates.
+      std::array<Tensor<1, dim>, 3> normals; ///< Unit outward, per edge.
+    };
+
+    /**
+     * The rule on @p reference_cell (triangle or quadrilateral), exact of
+     * degree @p degree on every reference sub-triangle.
+     */
+    DualCellQuadrature(const ReferenceCell &reference_cell,
+                       const unsigned int   degree);
+
+    /** The points and weights on the reference cell. */
+    const Quadrature<dim> &
+    quadrature() const;
+
+    /** The vertex a of the cell whose piece K ∩ D_a holds point @p q. */
+    unsigned int
+    vertex_of_point(const unsigned int q) const;
+
+    /** The sub-triangle that holds point @p q. */
+    unsigned int
+    sub_triangle_of_point(const unsigned int q) const;
+
+    /** The sub-triangles of the cell: two per vertex. */
+    const std::vector<SubTriangle> &
+    sub_triangles() const;
+
+  private:
+    std::vector<SubTriangle>  triangles;
+    Quadrature<dim>           rule;
+    std::vector<unsigned int> triangle_of_points;
+  };
+
+
+
+  /**
+   * The objects of §4.2–4.3 of the paper on the current mesh: the dual mesh
+   * D_h, λ_h as a function on it, and the flux reconstructions
+   * t_ih ∈ RT0(S_h), i = 1, 2.
+   *
+   * <h3>λ_h</h3>
+   * λ_h is the function equal to λ_a on the dual cell D_a (a ∈ V_h), with
+   * the λ_a of (4.5) (class DiscreteAction); on the pieces of a hanging
+   * vertex, the constraint-weighted mean of the λ_a of its parents; zero
+   * on the pieces of boundary vertices, the strip ω \ ω_h. Errors, both
+   * estimators and the output read λ_h through lambda_h_values() on the
+   * pieces of the DualCellQuadrature.
+   *
+   * <h3>The fluxes t_ih (4.13)</h3>
+   * On every sub-triangle κ = (a, m_e, b_K) ⊂ K, t_ih is the lowest order
+   * Raviart–Thomas field given by its three normal fluxes. On the two edges
+   * of κ inside K (m_e–b_K on ∂D_a, a–b_K inside D_a) the flux is that of
+   * the discrete flux of K,
+   *
+   *   ∫_e t_ih·n = −μ_i ∫_e ∇(u_ih|_K)·n,                            (4.13)
+   *
+   * so that t_ih is H(div)-conforming inside K. The remaining degree of
+   * freedom of κ is the flux through its half-edge a–m_e ⊂ ∂K, which κ
+   * shares with a sub-triangle κ' of the neighbour K'. It is chosen by
+   * local minimization: with the prescribed part P_κ of t_ih on κ (zero
+   * flux through a–m_e) and the Raviart–Thomas basis function ψ_κ of unit
+   * outward flux through a–m_e, the common normal flux density s across
+   * the half-edge minimizes
+   *
+   *   Σ_κ ‖μ_i^{-1/2} (P_κ + σ_κ ℓ_κ s ψ_κ) + μ_i^{1/2} ∇u_ih‖²_κ
+   *
+   * over the sub-triangles κ that touch it (ℓ_κ the length of κ's piece of
+   * the half-edge, σ_κ = ±1 its orientation), which is the distance of
+   * t_ih from the discrete flux −μ_i ∇u_ih that the flux estimator
+   * measures. This is the local minimization on D_a of the paper's
+   * reference [14], and it decouples: each half-edge is an independent
+   * one-dimensional problem,
+   *
+   *   s = Σ_κ σ_κ ℓ_κ (−μ_i ∇u_ih − P_κ, ψ_κ)_κ / Σ_κ ℓ_κ² ‖ψ_κ‖²_κ.
+   *
+   * On triangles, where −μ_i ∇u_ih is a constant in RT0(κ), s is the mean
+   * of the two one-sided fluxes of the neighbours weighted by ‖ψ_κ‖²_κ.
+   * The flux through half-edges on ∂ω is its own cell's (one κ). Since all
+   * half-edges a–m_e lie inside D_a, whatever their fluxes,
+   * ∫_{D_a} div t_ih = ∫_{∂D_a} t_ih·n involves only the fluxes (4.13), and
+   *
+   *   μ_i ∫ ∇u_ih·∇φ_a = ∫_{D_a} div t_ih                            (4.18)
+   *
+   * holds on triangles (P1 gradients are constant on K).
+   *
+   * <h3>Hanging nodes</h3>
+   * On an edge e of a coarse cell that holds a hanging vertex c, the two
+   * half-edges of e are covered from the other side by the four half-edges
+   * of the two small edges. The normal flux density is taken constant on
+   * all of e (one unknown s for the six sub-triangles along e, by the same
+   * minimization): t_ih is then H(div)-conforming across e, and (4.17) and
+   * (4.18) hold on triangles for the condensed hat functions φ_a = φ_a +
+   * Σ_c w_ca φ_c of the hanging node constraints, with D_a replaced by the
+   * weighted union Σ_c w_ca D_c: the coarse side's flux through the part
+   * of e in D_c, weighted by w_ca = 1/2 for both parents a, cancels the
+   * fine side's exactly when the density is the same on both halves of e.
+   *
+   * <h3>The equilibrated flux σ_ih</h3>
+   * For the flux estimator (see ErrorEstimator), σ_ih = t_ih + δ_ih, with
+   * δ_ih ∈ RT0 of the sub-triangles of D_a, zero normal flux on ∂D_a, and
+   * ∫_κ div σ_ih = ∫_κ (f_i + s_i λ_h) + γ_a |κ| on each of them. Around a
+   * the sub-triangles form a fan, neighbours sharing an edge through a;
+   * with y_j the flux of δ_ih from κ_j into κ_{j+1}, the conditions read
+   * y_j − y_{j−1} = r_j: the y_j are y_0 plus partial sums, γ_a makes them
+   * close around an interior vertex (Σ_j r_j = 0), and y_0 minimizes
+   * ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on D_a. On the dual cell of a
+   * boundary vertex the fan is open at ∂ω (no γ_a is needed). An edge
+   * with a hanging node cuts the fan (δ_ih = 0 there, so that σ_ih stays
+   * conforming), with a γ for each piece of the fan.
+   *
+   * <h3>Quadrilaterals</h3>
+   * The construction is the same on the pieces of Q1 cells, with the
+   * Raviart–Thomas fields mapped from the reference sub-triangles by the
+   * contravariant Piola transform t = DF t̂ / |det DF| of the bilinear map
+   * (which keeps normal fluxes through mapped edges, so t_ih is again
+   * H(div)-conforming; the same transform on triangles is the affine one) and
+   * the fluxes (4.13) integrated along the edges. The gradient of a Q1
+   * function is not constant on K, so (4.17) and (4.18) no longer hold
+   * exactly: identities() reports their defects instead.
+   */
+  template <int dim>
+  class FluxReconstruction
+  {
+  public:
+    using VectorType   = TrilinosWrappers::MPI::Vector;
+    using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
+
+    /** The defects of the identities of §4.3, relative to the data. */
+    struct Identities
+    {
+      /**
+       * (4.17): max over a ∈ V_h of |meas(D_a) − d_a| / d_a, with D_a the
+       * weighted union of dual cells of the condensed φ_a.
+       */
+      double measure_defect = 0;
+      /**
+       * (4.18): max over a and i of |∫_{D_a} div t_ih − μ_i ∫ ∇u_ih·∇φ_a|
+       * / F, F the force scale of (4.5).
+       */
+      double conservation_defect = 0;
+      /**
+       * Lemma 17, step 4: max over a and i of
+       * |±λ_a meas(D_a) − ∫_{D_a}(div t_ih − f_ih) + ∫(f_i − f_ih) φ_a| / F
+       * with λ_a from membrane i's formula of (4.5) and f_ih the mean of
+       * f_i on each cell (4.14).
+       */
+      double balance_defect = 0;
+    };
+
+    FluxReconstruction(const Discretization<dim> &discretization,
+                       const ProblemData<dim>    &data);
+
+    /** The quadrature on the pieces K ∩ D_a of every cell. */
+    const DualCellQuadrature<dim> &
+    dual_quadrature() const;
+
+    /**
+     * Use @p lambda_h (λ_a in the u1 slot of the vertices of
+     * @p dual_mesh_vertices, ghosted) as λ_h on @p dof_handler's mesh.
+     */
+    void
+    set_lambda_h(const DoFHandler<dim> &dof_handler,
+                 const VectorType      &lambda_h,
+                 const IndexSet        &dual_mesh_vertices);
+
+    /**
+     * λ_h at the points of dual_quadrature() on @p cell; with @p in_omega_h,
+     * also whether each point lies in ω_h (not in the strip along ∂ω).
+     */
+    void
+    lambda_h_values(const CellIterator  &cell,
+                    std::vector<double> &values,
+                    std::vector<bool>   *in_omega_h = nullptr) const;
+
+    /**
+     * Compute t_1h, t_2h for @p ghosted_solution on the locally owned cells,
+     * and the defects of the identities against the λ_a of @p action.
+     */
+    void
+    reconstruct(const VectorType                &ghosted_solution,
+                const AffineConstraints<double> &hanging_node_constraints,
+                const DiscreteAction<dim>       &action,
+                const IndexSet                  &locally_owned_dofs,
+                const MPI_Comm                   mpi_communicator);
+
+    /** The defects measured by the last reconstruct(). */
+    const Identities &
+    identities() const;
+
+    /**
+     * σ_ih and div σ_ih of membrane @p i at the points of dual_quadrature()
+     * on the cell @p fe_values was last reinit'ed on (with
+     * update_jacobians).
+     */
+    void
+    flux_values(const CellIterator          &cell,
+                const unsigned int           i,
+                const FEValues<dim>         &fe_values,
+                std::vector<Tensor<1, dim>> &fluxes,
+                std::vector<double>         &divergences) const;
+
+    /**
+     * f_i at the points of dual_quadrature() on @p cell, as evaluated by the
+     * last reconstruct().
+     */
+    ArrayView<const double>
+    load_values(const CellIterator &cell, const unsigned int i) const;
+
+    /**
+     * The sub-mesh S_h as patches for DataOutBase::write_vtu, with
+     * data_names(): on every sub-triangle the vertex a of its dual cell,
+     * λ_h, t_1h, t_2h (exact at the corners: RT0 fields are linear) and
+     * div t_ih.
+     */
+    std::vector<DataOutBase::Patch<dim, dim>>
+    patches() const;
+
+    /** The names of the data of patches(), in order. */
+    static std::vector<std::string>
+    data_names();
+
+  private:
+    /** What the reconstruction keeps of one sub-triangle κ. */
+    struct SubTriangleData
+    {
+      /** Outward normal fluxes of t_ih through the edges of κ, per i. */
+      std::array<std::array<double, 3>, 2> fluxes{};
+      /** The same for the equilibrated flux σ_ih. */
+      std::array<std::array<double, 3>, 2> equilibrated{};
+      /** (ψ_k, ψ_l)_κ for the mapped Raviart–Thomas basis of κ. */
+      std::array<std::array<double, 3>, 3> gram{};
+      /** (μ_i ∇u_ih, ψ_k)_κ. */
+      std::array<std::array<double, 3>, 2> discrete_flux{};
+      /** ∫_κ f_i and ∫_κ (f_i + s_i λ_h), s_1 = 1, s_2 = −1. */
+      std::array<double, 2> load{}, source{};
+      double                area = 0;
+    };
+
+    /** Ends of a chain of sub-triangles around a vertex (see links). */
+    static constexpr unsigned int free_end = numbers::invalid_unsigned_int;
+    static constexpr unsigned int zero_end = numbers::invalid_unsigned_int - 1;
+
+    /** λ_h on the pieces of vertex @p v of @p cell. */
+    double
+    lambda_h_value(const CellIterator &cell, const unsigned int v) const;
+
+    /** t̂ at the reference point @p x of sub-triangle @p s with @p fluxes. */
+    Tensor<1, dim>
+    reference_flux(const unsigned int           s,
+                   const std::array<double, 3> &fluxes,
+                   const Point<dim>            &x) const;
+
+    /** σ_ih = t_ih + δ_ih on every dual cell (see the class comment). */
+    void
+    equilibrate();
+
+    /**
+     * σ_ih on one chain of sub-triangles around a vertex, each given with
+     * the slot (0: edge 1, 1: edge 2) through which the chain enters it.
+     */
+    void
+    equilibrate_chain(
+      const std::vector<std::pair<unsigned int, unsigned int>> &chain,
+      const bool                                                starts_free,
+      const bool                                                closed);
+    const Discretization<dim>    &discretization;
+    const ProblemData<dim>       &data;
+    const DualCellQuadrature<dim> dual_cell_quadrature;
+
+    SmartPointer<const DoFHandler<dim>> dof_handler;
+    const VectorType                   *lambda_h;
+    IndexSet                            dual_mesh_vertices;
+
+    /** By active cell index × sub-triangles per cell + sub-triangle. */
+    std::vector<SubTriangleData> sub_triangle_data;
+    /**
+     * The neighbours of each sub-triangle in the fan around its vertex a:
+     * across edge 1 (a–b_K, the other half of the piece) and across edge 2
+     * (a–m_e, in the neighbour cell), or free_end (on ∂ω) or zero_end (on
+     * an edge with a hanging node).
+     */
+    std::vector<std::array<unsigned int, 2>> links;
+    /** The sub-triangles of every vertex's dual cell. */
+    std::vector<std::vector<unsigned int>> vertex_sub_triangles;
+    /** f_1, f_2 at the points of the dual quadrature, cell by cell. */
+    std::vector<double> load_at_points;
+    Identities          defects;
+  };
+} // namespace membranes
+
+#endif
