@@ -292,6 +292,12 @@ namespace membranes::Parameters
                       Bool(),
                       "Write u1, u2, u1-u2, lambda_h and the active set as "
                       "VTU, with a .pvd over cycles.");
+    prm.declare_entry("Write nodal values",
+                      "false",
+                      Bool(),
+                      "Write x, y, u1, u2, lambda_h and the active set at "
+                      "every vertex, in full precision, to "
+                      "nodal-values-NN.csv (one file per cycle).");
     prm.declare_entry("Flux reconstruction",
                       "false",
                       Bool(),
@@ -306,8 +312,9 @@ namespace membranes::Parameters
     directory = prm.get("Directory");
     if (directory.empty())
       throw invalid_entry("Output/Directory", "", "a directory name is needed");
-    report    = prm.get_bool("Report");
-    write_vtu = prm.get_bool("Write vtu");
+    report             = prm.get_bool("Report");
+    write_vtu          = prm.get_bool("Write vtu");
+    write_nodal_values = prm.get_bool("Write nodal values");
     if (prm.get_bool("Flux reconstruction"))
       throw invalid_entry("Output/Flux reconstruction",
                           "true",
