@@ -4,9 +4,34 @@
 #include <limits>
 #include <membranes/active_set_solver.h>
 #include <membranes/coupled_system.h>
+#include <membranes/decoupled_system.h>
 
 namespace membranes
 {
+  namespace
+  {
+    /** The linear problem of one iteration, as `Solver/Method` asks. */
+    template <int dim>
+    std::unique_ptr<ActiveSetSystem<dim>>
+    make_active_set_system(const Parameters::Solver  &parameters,
+                           const Discretization<dim> &discretization,
+                           const ProblemData<dim>    &data,
+                           const MPI_Comm             mpi_communicator)
+    {
+      if (parameters.method == Parameters::SolverMethod::decoupled)
+        return std::make_unique<DecoupledSystem<dim>>(parameters,
+                                                      discretization,
+                                                      data,
+                                                      mpi_communicator);
+      return std::make_unique<CoupledSystem<dim>>(parameters,
+                                                  discretization,
+                                                  data,
+                                                  mpi_communicator);
+    }
+  } // namespace
+
+
+
   template <int dim>
   ActiveSetSolver<dim>::ActiveSetSolver(
     const Parameters::Solver  &parameters,
@@ -18,10 +43,10 @@ namespace membranes
     , data(data)
     , pcout(pcout)
     , mpi_communicator(mpi_communicator)
-    , system(std::make_unique<CoupledSystem<dim>>(parameters,
-                                                  discretization,
-                                                  data,
-                                                  mpi_communicator))
+    , system(make_active_set_system(parameters,
+                                    discretization,
+                                    data,
+                                    mpi_communicator))
   {}
 
 

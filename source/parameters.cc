@@ -184,11 +184,8 @@ namespace membranes::Parameters
   Solver::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Solver");
-    if (prm.get("Method") == "decoupled")
-      throw invalid_entry("Solver/Method",
-                          "decoupled",
-                          "only 'coupled' is available in this version");
-    method                    = SolverMethod::coupled;
+    method = (prm.get("Method") == "decoupled" ? SolverMethod::decoupled :
+                                                 SolverMethod::coupled);
     const std::string ls      = prm.get("Linear solver");
     linear_solver             = (ls == "direct" ? LinearSolverType::direct :
                                  ls == "cg-amg" ? LinearSolverType::cg_amg :

@@ -99,7 +99,10 @@ def compare_column(column, first, second, rtol, atol, scale_by_column):
                f"{fmt(largest[1])}{relative_to} over {len(pairs)} rows "
                f"(atol {fmt(atol)}, rtol {fmt(rtol)})")
     if mismatches:
-        message += "; differ at " + ", ".join(mismatches)
+        shown = 5
+        message += (f"; differ at {len(mismatches)} rows: "
+                    + ", ".join(mismatches[:shown])
+                    + (", ..." if len(mismatches) > shown else ""))
     return not mismatches, message
 
 

@@ -29,9 +29,11 @@ namespace membranes
    * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
    * obstacle problem for w = u1 − u2, SPEC §1), so the test does not depend
    * on how the data are scaled. Each iteration solves the linear problem
-   * W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem) on the coupled pair
-   * (CoupledSystem); λ_a, the next active set and the KKT residual are
-   * computed from its solution.
+   * W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the coupled pair
+   * (CoupledSystem, `Solver/Method = coupled`) or on the sum and the
+   * difference of the membranes (DecoupledSystem, `decoupled`). Both give
+   * the same iterate; λ_a, the next active set and the KKT residual are
+   * computed from it in the same way.
    *
    * The iteration stops when the active set repeats and the relative KKT
    * residual (see kkt_residual()) is at most `Tolerance`. If that does not

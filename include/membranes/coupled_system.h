@@ -3,14 +3,7 @@
 
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
-#include <deal.II/lac/trilinos_vector.h>
 #include <membranes/active_set_system.h>
-#include <membranes/discrete_action.h>
-#include <membranes/discretization.h>
-#include <membranes/linear_solver.h>
-#include <membranes/parameters.h>
-#include <membranes/problem_data.h>
 
 namespace membranes
 {
@@ -25,9 +18,8 @@ namespace membranes
    * the boundary values u1 = g_h, u2 = g2_h. Condensing the constraint adds
    * the equations of u1 and u2 at a, so the solution of each iteration
    * satisfies Prop. 12 (λ from either membrane) by construction; on
-   * inactive vertices both equations hold, i.e. λ_a = 0. The condensed
-   * system is symmetric positive definite; it is assembled from CellSystem
-   * and solved by LinearSolver.
+   * inactive vertices both equations hold, i.e. λ_a = 0. The system is
+   * assembled from CellSystem.
    */
   template <int dim>
   class CoupledSystem : public ActiveSetSystem<dim>
@@ -63,30 +55,15 @@ namespace membranes
           const double               tolerance,
           ActiveSetStatistics       &statistics) override;
 
-    std::string
-    description() const override;
-
   private:
     /** Hanging-node, contact and boundary constraints for @p active_set. */
     void
     make_constraints(const DiscreteAction<dim> &action,
                      const IndexSet            &active_set);
 
-    /** The condensed system for the current constraints. */
-    void
-    assemble_system();
-
-    const Discretization<dim> &discretization;
-    const ProblemData<dim>    &data;
-    const MPI_Comm             mpi_communicator;
-
     SmartPointer<const DoFHandler<dim>> dof_handler;
     IndexSet                            locally_relevant_dofs;
-
-    AffineConstraints<double>      constraints;
-    TrilinosWrappers::SparseMatrix system_matrix;
-    VectorType                     system_rhs;
-    LinearSolver<dim>              linear_solver;
+    AffineConstraints<double>           constraints;
   };
 } // namespace membranes
 
