@@ -1,18 +1,37 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
-#include <deal.II/dofs/dof_tools.h>
-#include <deal.II/fe/fe_values.h>
-#include <deal.II/lac/dynamic_sparsity_pattern.h>
-#include <deal.II/lac/sparsity_tools.h>
-#include <deal.II/numerics/vector_tools.h>
 #include <limits>
-#include <map>
 #include <membranes/active_set_solver.h>
-#include <membranes/cell_system.h>
+#include <membranes/coupled_system.h>
+#include <membranes/decoupled_system.h>
 
 namespace membranes
 {
+  namespace
+  {
+    /** The linear problem of one iteration, as `Solver/Method` asks. */
+    template <int dim>
+    std::unique_ptr<ActiveSetSystem<dim>>
+    make_active_set_system(const Parameters::Solver  &parameters,
+                           const Discretization<dim> &discretization,
+                           const ProblemData<dim>    &data,
+                           const MPI_Comm             mpi_communicator)
+    {
+      if (parameters.method == Parameters::SolverMethod::decoupled)
+        return std::make_unique<DecoupledSystem<dim>>(parameters,
+                                                      discretization,
+                                                      data,
+                                                      mpi_communicator);
+      return std::make_unique<CoupledSystem<dim>>(parameters,
+                                                  discretization,
+                                                  data,
+                                                  mpi_communicator);
+    }
+  } // namespace
+
+
+
   template <int dim>
   ActiveSetSolver<dim>::ActiveSetSolver(
     const Parameters::Solver  &parameters,
@@ -21,11 +40,13 @@ namespace membranes
     const ConditionalOStream  &pcout,
     const MPI_Comm             mpi_communicator)
     : parameters(parameters)
-    , discretization(discretization)
     , data(data)
     , pcout(pcout)
     , mpi_communicator(mpi_communicator)
-    , linear_solver(parameters.linear_solver, mpi_communicator)
+    , system(make_active_set_system(parameters,
+                                    discretization,
+                                    data,
+                                    mpi_communicator))
   {}
 
 
@@ -40,76 +61,10 @@ namespace membranes
     this->dof_handler           = &dof_handler;
     this->locally_owned_dofs    = locally_owned_dofs;
     this->locally_relevant_dofs = locally_relevant_dofs;
-    linear_solver.reinit(dof_handler);
-
-    // The contact constraint u1(a) = u2(a) only ever couples DoFs of
-    // vertices that share a cell, so the full coupling of all DoFs of a
-    // cell (condensed with the hanging node constraints) holds the matrix
-    // of every active set. Boundary rows are constrained for good.
-    make_constraints(action, IndexSet(dof_handler.n_dofs()));
-    DynamicSparsityPattern dsp(locally_relevant_dofs);
-    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
-    SparsityTools::distribute_sparsity_pattern(dsp,
-                                               locally_owned_dofs,
-                                               mpi_communicator,
-                                               locally_relevant_dofs);
-    system_matrix.reinit(locally_owned_dofs,
-                         locally_owned_dofs,
-                         dsp,
-                         mpi_communicator);
-    system_rhs.reinit(locally_owned_dofs, mpi_communicator);
-  }
-
-
-
-  template <int dim>
-  void
-  ActiveSetSolver<dim>::make_constraints(const DiscreteAction<dim> &action,
-                                         const IndexSet            &active_set)
-  {
-    constraints.clear();
-    constraints.reinit(locally_relevant_dofs);
-    DoFTools::make_hanging_node_constraints(*dof_handler, constraints);
-
-    for (const auto &a : action.vertices())
-      if (active_set.is_element(a.dof[0]))
-        {
-          constraints.add_line(a.dof[0]);
-          constraints.add_entry(a.dof[0], a.dof[1], 1.0);
-        }
-
-    std::map<types::boundary_id, const Function<dim> *> boundary_functions;
-    for (const auto id : dof_handler->get_triangulation().get_boundary_ids())
-      boundary_functions[id] = &data.boundary_values();
-    VectorTools::interpolate_boundary_values(*discretization.mapping,
-                                             *dof_handler,
-                                             boundary_functions,
-                                             constraints);
-    constraints.close();
-  }
-
-
-
-  template <int dim>
-  void
-  ActiveSetSolver<dim>::assemble_system()
-  {
-    system_matrix = 0;
-    system_rhs    = 0;
-
-    CellSystem<dim> cell_system(discretization, data);
-    for (const auto &cell : dof_handler->active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          cell_system.reinit(cell);
-          constraints.distribute_local_to_global(cell_system.matrix,
-                                                 cell_system.rhs,
-                                                 cell_system.dof_indices,
-                                                 system_matrix,
-                                                 system_rhs);
-        }
-    system_matrix.compress(VectorOperation::add);
-    system_rhs.compress(VectorOperation::add);
+    system->setup(dof_handler,
+                  locally_owned_dofs,
+                  locally_relevant_dofs,
+                  action);
   }
 
 
@@ -210,25 +165,19 @@ namespace membranes
     ghosted_solution = solution;
     action.compute(ghosted_solution);
 
+    // The forces of the last iterate set the scale of the linear solver's
+    // residual: a hundredth of what the KKT test allows.
+    const auto linear_tolerance = [&]() {
+      return 1e-2 * parameters.tolerance * action.force_scale_l2();
+    };
+    system->prepare(solution, linear_tolerance(), statistics);
+
     for (unsigned int iteration = 1;; ++iteration)
       {
-        timer.restart();
-        make_constraints(action, active_set);
-        constraints.distribute(solution);
-        assemble_system();
-        statistics.assembly_time += timer.wall_time();
+        system->solve(
+          action, active_set, solution, linear_tolerance(), statistics);
 
-        // The forces of the last iterate set the scale of the linear
-        // solver's residual: a hundredth of what the KKT test allows.
         timer.restart();
-        const double linear_tolerance =
-          1e-2 * parameters.tolerance * action.force_scale_l2();
-        statistics.linear_iterations += linear_solver.solve(system_matrix,
-                                                            solution,
-                                                            system_rhs,
-                                                            linear_tolerance);
-        constraints.distribute(solution);
-
         ghosted_solution = solution;
         action.compute(ghosted_solution);
         const IndexSet next_active_set =
@@ -246,7 +195,7 @@ namespace membranes
         pcout << "      active set iteration " << iteration << ": "
               << Utilities::MPI::sum(active_set.n_elements(), mpi_communicator)
               << " active vertices, relative KKT residual "
-              << statistics.kkt_residual << ", " << linear_solver.method()
+              << statistics.kkt_residual << ", " << system->description()
               << std::endl;
 
         active_set = next_active_set;

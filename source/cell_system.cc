@@ -5,22 +5,33 @@ namespace membranes
   template <int dim>
   CellSystem<dim>::CellSystem(const Discretization<dim> &discretization,
                               const ProblemData<dim>    &data)
-    : matrix(discretization.fe->n_dofs_per_cell(),
+    : laplace_matrix(discretization.fe->base_element(0).n_dofs_per_cell(),
+                     discretization.fe->base_element(0).n_dofs_per_cell())
+    , matrix(discretization.fe->n_dofs_per_cell(),
              discretization.fe->n_dofs_per_cell())
     , rhs(discretization.fe->n_dofs_per_cell())
     , lumped_mass(discretization.fe->n_dofs_per_cell())
     , dof_indices(discretization.fe->n_dofs_per_cell())
     , data(data)
     , fe_values(*discretization.mapping,
-                *discretization.fe,
+                discretization.fe->base_element(0),
                 discretization.cell_quadrature,
                 update_values | update_gradients | update_quadrature_points |
                   update_JxW_values)
+    , scalar_lumped_mass(discretization.fe->base_element(0).n_dofs_per_cell())
   {
-    for (unsigned int i = 0; i < discretization.fe->n_dofs_per_cell(); ++i)
-      membrane.push_back(discretization.fe->system_to_component_index(i).first);
-    for (auto &load : loads)
-      load.resize(fe_values.n_quadrature_points);
+    for (unsigned int j = 0; j < discretization.fe->n_dofs_per_cell(); ++j)
+      {
+        const auto component_and_index =
+          discretization.fe->system_to_component_index(j);
+        membrane.push_back(component_and_index.first);
+        scalar_index.push_back(component_and_index.second);
+      }
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        loads[i].reinit(laplace_matrix.m());
+        load_values[i].resize(fe_values.n_quadrature_points);
+      }
   }
 
 
@@ -30,37 +41,54 @@ namespace membranes
   CellSystem<dim>::reinit(
     const typename DoFHandler<dim>::active_cell_iterator &cell)
   {
-    fe_values.reinit(cell);
+    // The FEValues object belongs to the scalar element, not to the
+    // DoFHandler's FESystem: it sees the cell only as a cell of the mesh.
+    fe_values.reinit(typename Triangulation<dim>::cell_iterator(cell));
     cell->get_dof_indices(dof_indices);
-    for (unsigned int c = 0; c < 2; ++c)
-      data.load(c).value_list(fe_values.get_quadrature_points(), loads[c]);
+    for (unsigned int i = 0; i < 2; ++i)
+      data.load(i).value_list(fe_values.get_quadrature_points(),
+                              load_values[i]);
 
-    matrix      = 0;
-    rhs         = 0;
-    lumped_mass = 0;
-    // Both base elements are primitive: shape_grad(i, q) is the gradient of
-    // the one non-zero component of φ_i, and the membranes do not couple.
+    laplace_matrix     = 0;
+    scalar_lumped_mass = 0;
+    for (auto &load : loads)
+      load = 0;
     for (const unsigned int q : fe_values.quadrature_point_indices())
-      for (const unsigned int i : fe_values.dof_indices())
+      for (const unsigned int v : fe_values.dof_indices())
         {
-          const unsigned int c = membrane[i];
-          for (const unsigned int j : fe_values.dof_indices())
-            if (membrane[j] == c)
-              matrix(i, j) += data.mu[c] * fe_values.shape_grad(i, q) *
-                              fe_values.shape_grad(j, q) * fe_values.JxW(q);
-          rhs(i) +=
-            loads[c][q] * fe_values.shape_value(i, q) * fe_values.JxW(q);
-          lumped_mass(i) += fe_values.shape_value(i, q) * fe_values.JxW(q);
+          for (const unsigned int w : fe_values.dof_indices())
+            laplace_matrix(v, w) += fe_values.shape_grad(v, q) *
+                                    fe_values.shape_grad(w, q) *
+                                    fe_values.JxW(q);
+          for (unsigned int i = 0; i < 2; ++i)
+            loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
+                           fe_values.JxW(q);
+          scalar_lumped_mass(v) +=
+            fe_values.shape_value(v, q) * fe_values.JxW(q);
         }
+
+    // The membranes do not couple in (3.4): the FESystem's matrix is block
+    // diagonal, one block μ_i A_K per membrane.
+    for (unsigned int j = 0; j < dof_indices.size(); ++j)
+      {
+        const unsigned int c = membrane[j];
+        for (unsigned int k = 0; k < dof_indices.size(); ++k)
+          matrix(j, k) =
+            (membrane[k] == c ?
+               data.mu[c] * laplace_matrix(scalar_index[j], scalar_index[k]) :
+               0.);
+        rhs(j)         = loads[c](scalar_index[j]);
+        lumped_mass(j) = scalar_lumped_mass(scalar_index[j]);
+      }
   }
 
 
 
   template <int dim>
   unsigned int
-  CellSystem<dim>::membrane_of(const unsigned int i) const
+  CellSystem<dim>::scalar_index_of(const unsigned int j) const
   {
-    return membrane[i];
+    return scalar_index[j];
   }
 
 

@@ -49,8 +49,10 @@ namespace membranes
         {
           cell_system.reinit(cell);
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            local_stiffness(i) =
-              cell_system.matrix(i, i) / data.mu[cell_system.membrane_of(i)];
+            {
+              const unsigned int v = cell_system.scalar_index_of(i);
+              local_stiffness(i)   = cell_system.laplace_matrix(v, v);
+            }
           hanging_node_constraints.distribute_local_to_global(
             cell_system.lumped_mass,
             cell_system.dof_indices,

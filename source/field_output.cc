@@ -3,6 +3,8 @@
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 #include <fstream>
+#include <iomanip>
+#include <map>
 #include <membranes/field_output.h>
 
 namespace membranes
@@ -68,6 +70,23 @@ namespace membranes
                           const VectorType      &contact_fields,
                           const Vector<double>  *indicators)
   {
+    if (parameters.write_vtu)
+      write_vtu(
+        cycle, dof_handler, ghosted_solution, contact_fields, indicators);
+    if (parameters.write_nodal_values)
+      write_nodal_values(cycle, dof_handler, ghosted_solution, contact_fields);
+  }
+
+
+
+  template <int dim>
+  void
+  FieldOutput<dim>::write_vtu(const unsigned int     cycle,
+                              const DoFHandler<dim> &dof_handler,
+                              const VectorType      &ghosted_solution,
+                              const VectorType      &contact_fields,
+                              const Vector<double>  *indicators)
+  {
     const GapPostprocessor<dim> gap;
     DataOut<dim>                data_out;
     data_out.attach_dof_handler(dof_handler);
@@ -132,6 +151,46 @@ namespace membranes
                      [&](std::ostream &out) {
                        DataOutBase::write_pvd_record(out, written);
                      });
+  }
+
+
+
+  template <int dim>
+  void
+  FieldOutput<dim>::write_nodal_values(const unsigned int     cycle,
+                                       const DoFHandler<dim> &dof_handler,
+                                       const VectorType      &ghosted_solution,
+                                       const VectorType &contact_fields) const
+  {
+    // Every vertex once, by its u1 DoF: its position and its u2 DoF.
+    const FiniteElement<dim>            &fe = dof_handler.get_fe();
+    std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
+    std::map<types::global_dof_index,
+             std::pair<Point<dim>, types::global_dof_index>>
+      vertices;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      {
+        cell->get_dof_indices(dof_indices);
+        for (const unsigned int v : cell->vertex_indices())
+          vertices.emplace(
+            dof_indices[fe.component_to_system_index(0, v)],
+            std::make_pair(cell->vertex(v),
+                           dof_indices[fe.component_to_system_index(1, v)]));
+      }
+
+    const std::string name = parameters.directory + "/nodal-values-" +
+                             Utilities::int_to_string(cycle, 2) + ".csv";
+    write_atomically(name, [&](std::ostream &out) {
+      out << std::setprecision(17) << "x,y,u1,u2,lambda_h,active_set\n";
+      for (const auto &[u1_dof, vertex] : vertices)
+        {
+          const auto &[point, u2_dof] = vertex;
+          out << point[0] << ',' << point[1] << ',' << ghosted_solution[u1_dof]
+              << ',' << ghosted_solution[u2_dof] << ','
+              << contact_fields[u1_dof] << ',' << contact_fields[u2_dof]
+              << '\n';
+        }
+    });
   }
 
 

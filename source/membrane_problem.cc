@@ -300,12 +300,15 @@ namespace membranes
 
 
 
-  /** u1, u2, u1 − u2, λ_h and the active set, if the scene asks for them. */
+  /**
+   * u1, u2, u1 − u2, λ_h and the active set as VTU, and the nodal values as
+   * CSV, if the scene asks for them.
+   */
   template <int dim>
   void
   MembraneProblem<dim>::output_results(const unsigned int cycle)
   {
-    if (!parameters.output.write_vtu)
+    if (!parameters.output.write_vtu && !parameters.output.write_nodal_values)
       return;
     VectorType contact_fields(locally_owned_dofs, mpi_communicator);
     contact_fields = 0;
@@ -324,7 +327,7 @@ namespace membranes
                        ghosted_solution,
                        ghosted_fields,
                        indicators.size() ? &indicators : nullptr);
-    if (parameters.output.flux_reconstruction)
+    if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
                                    flux_reconstruction.patches(),
                                    flux_reconstruction.data_names());

@@ -184,11 +184,8 @@ namespace membranes::Parameters
   Solver::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Solver");
-    if (prm.get("Method") == "decoupled")
-      throw invalid_entry("Solver/Method",
-                          "decoupled",
-                          "only 'coupled' is available in this version");
-    method                    = SolverMethod::coupled;
+    method = (prm.get("Method") == "decoupled" ? SolverMethod::decoupled :
+                                                 SolverMethod::coupled);
     const std::string ls      = prm.get("Linear solver");
     linear_solver             = (ls == "direct" ? LinearSolverType::direct :
                                  ls == "cg-amg" ? LinearSolverType::cg_amg :
@@ -292,6 +289,12 @@ namespace membranes::Parameters
                       Bool(),
                       "Write u1, u2, u1-u2, lambda_h and the active set as "
                       "VTU, with a .pvd over cycles.");
+    prm.declare_entry("Write nodal values",
+                      "false",
+                      Bool(),
+                      "Write x, y, u1, u2, lambda_h and the active set at "
+                      "every vertex, in full precision, to "
+                      "nodal-values-NN.csv (one file per cycle).");
     prm.declare_entry("Flux reconstruction",
                       "false",
                       Bool(),
@@ -313,6 +316,7 @@ namespace membranes::Parameters
       throw invalid_entry("Output/Directory", "", "a directory name is needed");
     report              = prm.get_bool("Report");
     write_vtu           = prm.get_bool("Write vtu");
+    write_nodal_values  = prm.get_bool("Write nodal values");
     flux_reconstruction = prm.get_bool("Flux reconstruction");
     prm.leave_subsection();
   }

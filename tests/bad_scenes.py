@@ -116,7 +116,7 @@ def check_good_command_lines(membranes):
              "lambda", "Method", "Linear solver", "Tolerance",
              "Max active set iterations", "Strategy", "Cycles", "Marking",
              "Bulk parameter", "Coarsen fraction", "Max dofs", "Estimator", "Directory", "Report",
-             "Write vtu", "Flux reconstruction"]
+             "Write vtu", "Write nodal values", "Flux reconstruction"]
     missing = [n for n in names if "set %s " % n not in printed.stdout]
     ok &= printed.returncode == 0 and not missing
     print("%s --help and --print-parameters%s" %

@@ -1,16 +1,21 @@
 #!/usr/bin/env python3
-"""Compare selected columns of two membranes report.csv files row by row.
+"""Compare selected columns of two CSV files row by row: membranes
+report.csv files, or the nodal-values-NN.csv files of two runs.
 
 Usage::
 
     compare_reports.py a.csv b.csv --columns c1,c2,... --rtol R [--atol A]
+                       [--scale value|column]
 
 The files must have the same number of data rows, and for every named column
 and every row the two values must satisfy
 
-    |a - b| <= atol + rtol * max(|a|, |b|)        (atol defaults to 0),
+    |a - b| <= atol + rtol * S                    (atol defaults to 0),
 
-so with ``--rtol 0`` (and no ``--atol``) the values must be equal, which is
+with S = max(|a|, |b|) (``--scale value``, the default), or S the largest
+|a| or |b| over the whole column (``--scale column``: the difference relative
+to the max norm, the right measure for nodal values that pass through zero).
+With ``--rtol 0`` (and no ``--atol``) the values must be equal, which is
 the right test for integer columns such as ``dofs`` or ``active_vertices``.
 Two empty fields agree; an empty field never agrees with a number; NaN never
 agrees with anything.  Columns are looked up by name in each file's header.
@@ -41,46 +46,63 @@ def fmt(value):
     return "empty" if value is None else f"{value:.6g}"
 
 
-def values_agree(a, b, rtol, atol):
-    """Whether two parsed fields agree within the tolerance."""
+def values_agree(a, b, rtol, atol, scale):
+    """Whether two parsed fields agree within the tolerance; ``scale`` is
+    S of the module docstring, or None for max(|a|, |b|)."""
     if a is None or b is None:
         return a is None and b is None
     if a == b:  # also covers equal infinities
         return True
-    return abs(a - b) <= atol + rtol * max(abs(a), abs(b))
+    if scale is None:
+        scale = max(abs(a), abs(b))
+    return abs(a - b) <= atol + rtol * scale
 
 
-def differences(a, b):
-    """(|a - b|, |a - b| / max(|a|, |b|)) for reporting; None if undefined."""
+def differences(a, b, scale):
+    """(|a - b|, |a - b| / S) for reporting; None if undefined."""
     if a is None or b is None or math.isnan(a) or math.isnan(b):
         return None
     if a == b:
         return 0.0, 0.0
     absolute = abs(a - b)
-    return absolute, absolute / max(abs(a), abs(b))
+    return absolute, absolute / (max(abs(a), abs(b)) if scale is None
+                                 else scale)
 
 
-def compare_column(column, first, second, rtol, atol):
+def column_scale(values):
+    """The largest |value| of a column (None values skipped)."""
+    return max((abs(v) for v in values if v is not None), default=0.0)
+
+
+def compare_column(column, first, second, rtol, atol, scale_by_column):
     """Compare one column; return (passed, message)."""
     (path_a, rows_a), (path_b, rows_b) = first, second
-    pairs = list(zip(rows_a, rows_b))
+    pairs = [(record_a[column], record_b[column])
+             for record_a, record_b in zip(rows_a, rows_b)]
+    numbers = [(parse_number(text_a, path_a, column),
+                parse_number(text_b, path_b, column))
+               for text_a, text_b in pairs]
+    scale = (column_scale([v for pair in numbers for v in pair])
+             if scale_by_column else None)
     mismatches = []
     largest = [0.0, 0.0]
-    for row, (record_a, record_b) in enumerate(pairs):
-        text_a, text_b = record_a[column], record_b[column]
-        a = parse_number(text_a, path_a, column)
-        b = parse_number(text_b, path_b, column)
-        diff = differences(a, b)
+    for row, ((text_a, text_b), (a, b)) in enumerate(zip(pairs, numbers)):
+        diff = differences(a, b, scale)
         if diff is not None:
             largest = [max(old, new) for old, new in zip(largest, diff)]
-        if not values_agree(a, b, rtol, atol):
+        if not values_agree(a, b, rtol, atol, scale):
             mismatches.append(f"row {row}: {text_a or 'empty'} vs "
                               f"{text_b or 'empty'}")
+    relative_to = ("" if scale is None else
+                   f" (to the column's max {fmt(scale)})")
     message = (f"max |a-b| {fmt(largest[0])}, max relative "
-               f"{fmt(largest[1])} over {len(pairs)} rows "
+               f"{fmt(largest[1])}{relative_to} over {len(pairs)} rows "
                f"(atol {fmt(atol)}, rtol {fmt(rtol)})")
     if mismatches:
-        message += "; differ at " + ", ".join(mismatches)
+        shown = 5
+        message += (f"; differ at {len(mismatches)} rows: "
+                    + ", ".join(mismatches[:shown])
+                    + (", ..." if len(mismatches) > shown else ""))
     return not mismatches, message
 
 
@@ -116,6 +138,10 @@ def parse_arguments(argv):
                         help="relative tolerance")
     parser.add_argument("--atol", type=non_negative_float, default=0.0,
                         help="absolute tolerance (default 0)")
+    parser.add_argument("--scale", choices=("value", "column"),
+                        default="value",
+                        help="relative to max(|a|, |b|) of each row (value) "
+                        "or of the whole column (column)")
     return parser.parse_args(argv)
 
 
@@ -143,7 +169,8 @@ def compare(arguments):
         try:
             passed, message = compare_column(
                 column, (arguments.first, rows_a),
-                (arguments.second, rows_b), arguments.rtol, arguments.atol)
+                (arguments.second, rows_b), arguments.rtol, arguments.atol,
+                arguments.scale == "column")
         except ReportError as error:
             passed, message = False, str(error)
         verdicts.append(report_line(passed, column, message))

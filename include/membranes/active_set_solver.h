@@ -4,14 +4,13 @@
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
-#include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <membranes/active_set_system.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
-#include <membranes/linear_solver.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
+#include <memory>
 
 namespace membranes
 {
@@ -19,8 +18,8 @@ namespace membranes
 
   /**
    * The primal-dual active set method (a semismooth Newton method) for the
-   * discrete variational inequality (3.4), as in deal.II's step-41 but on
-   * the coupled pair (u1, u2).
+   * discrete variational inequality (3.4), as in deal.II's step-41 but for
+   * the pair (u1, u2).
    *
    * With W_a = u1h(a) − u2h(a) and the nodal multiplier Λ_a = λ_a of (4.5),
    * the active set is
@@ -29,13 +28,12 @@ namespace membranes
    *
    * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
    * obstacle problem for w = u1 − u2, SPEC §1), so the test does not depend
-   * on how the data are scaled. On active vertices the constraint
-   * u1(a) = u2(a) is a line of an AffineConstraints object, together with
-   * hanging-node constraints and the boundary values u1 = g_h, u2 = g2_h;
-   * on inactive vertices both equations hold, i.e. Λ_a = 0. Condensing
-   * the constraint adds the equations of u1 and u2 at a, so the solution of
-   * each iteration satisfies Prop. 12 (λ from either membrane) by
-   * construction.
+   * on how the data are scaled. Each iteration solves the linear problem
+   * W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the coupled pair
+   * (CoupledSystem, `Solver/Method = coupled`) or on the sum and the
+   * difference of the membranes (DecoupledSystem, `decoupled`). Both give
+   * the same iterate; λ_a, the next active set and the KKT residual are
+   * computed from it in the same way.
    *
    * The iteration stops when the active set repeats and the relative KKT
    * residual (see kkt_residual()) is at most `Tolerance`. If that does not
@@ -46,16 +44,7 @@ namespace membranes
   {
   public:
     using VectorType = TrilinosWrappers::MPI::Vector;
-
-    /** What one solve() did. */
-    struct Statistics
-    {
-      unsigned int iterations        = 0; ///< Active set iterations.
-      unsigned int linear_iterations = 0; ///< CG iterations, summed.
-      double       kkt_residual      = 0; ///< Relative KKT residual at the end.
-      double       assembly_time     = 0; ///< Seconds spent assembling.
-      double       solve_time = 0; ///< Seconds in linear solves and updates.
-    };
+    using Statistics = ActiveSetStatistics;
 
     ActiveSetSolver(const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,
@@ -63,10 +52,7 @@ namespace membranes
                     const ConditionalOStream  &pcout,
                     const MPI_Comm             mpi_communicator);
 
-    /**
-     * Sparsity pattern and matrix for the current mesh; the pattern has room
-     * for any active set.
-     */
+    /** The linear systems for the current mesh (ActiveSetSystem::setup()). */
     void
     setup(const DoFHandler<dim>     &dof_handler,
           const IndexSet            &locally_owned_dofs,
@@ -120,29 +106,17 @@ namespace membranes
                    const VectorType          &ghosted_solution,
                    const LambdaOfVertex      &lambda) const;
 
-    /** Hanging-node, contact and boundary constraints for @p active_set. */
-    void
-    make_constraints(const DiscreteAction<dim> &action,
-                     const IndexSet            &active_set);
-
-    /** The condensed system for the current constraints. */
-    void
-    assemble_system();
-
-    const Parameters::Solver  &parameters;
-    const Discretization<dim> &discretization;
-    const ProblemData<dim>    &data;
-    const ConditionalOStream  &pcout;
-    const MPI_Comm             mpi_communicator;
+    const Parameters::Solver &parameters;
+    const ProblemData<dim>   &data;
+    const ConditionalOStream &pcout;
+    const MPI_Comm            mpi_communicator;
 
     SmartPointer<const DoFHandler<dim>> dof_handler;
     IndexSet                            locally_owned_dofs;
     IndexSet                            locally_relevant_dofs;
 
-    AffineConstraints<double>      constraints;
-    TrilinosWrappers::SparseMatrix system_matrix;
-    VectorType                     system_rhs;
-    LinearSolver<dim>              linear_solver;
+    /** The linear problem of one iteration, coupled or decoupled. */
+    std::unique_ptr<ActiveSetSystem<dim>> system;
   };
 } // namespace membranes
 

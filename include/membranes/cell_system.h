@@ -15,17 +15,25 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * The contributions of one cell K to the reduced problem (3.4), for the
-   * shape functions φ_i of the FESystem (component c(i) = 0 for u1, 1 for
-   * u2):
+   * The contributions of one cell K to the reduced problem (3.4).
    *
-   *   A_K(i, j) = μ_c ∫_K ∇φ_i·∇φ_j  if c(i) = c(j), 0 otherwise,
-   *   F_K(i)    = ∫_K f_c φ_i,
-   *   M_K(i)    = ∫_K φ_i  (the lumped mass, whose sums are d_a = ∫ φ_a).
+   * First for the hat functions φ_v of the scalar element (P1 or Q1, the
+   * base element of the FESystem; v numbers the vertices of K):
    *
-   * The active set solver assembles the system from them, and the discrete
-   * action evaluates the residual of (4.5) as A_K U_K − F_K with them, so
-   * both see the same bilinear form and the same quadrature of the loads.
+   *   A_K(v, w)  = ∫_K ∇φ_v·∇φ_w   (the Laplacian),
+   *   F_iK(v)    = ∫_K f_i φ_v      (the load of membrane i),
+   *   m_K(v)     = ∫_K φ_v          (the lumped mass, whose sums are d_a).
+   *
+   * Then, from these, for the shape functions φ_j of the FESystem
+   * (component c(j) = 0 for u1, 1 for u2, hat function v(j)):
+   *
+   *   matrix(j, k) = μ_c A_K(v(j), v(k))  if c(j) = c(k), 0 otherwise,
+   *   rhs(j)       = F_cK(v(j)),    lumped_mass(j) = m_K(v(j)).
+   *
+   * The coupled active set solver assembles its system from the FESystem
+   * parts, the decoupled one its scalar systems from A_K and F_iK, and the
+   * discrete action evaluates the residual of (4.5) as matrix U_K − rhs:
+   * all see the same bilinear form and the same quadrature of the loads.
    */
   template <int dim>
   class CellSystem
@@ -34,24 +42,32 @@ namespace membranes
     CellSystem(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /** Compute matrix, rhs, lumped_mass and dof_indices on @p cell. */
+    /** Compute every matrix and vector below on @p cell, a cell of the
+     * DoFHandler of the FESystem. */
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell);
+
+    /** A_K of the scalar element. */
+    FullMatrix<double> laplace_matrix;
+    /** F_1K and F_2K of the scalar element. */
+    std::array<Vector<double>, 2> loads;
 
     FullMatrix<double>                   matrix;
     Vector<double>                       rhs;
     Vector<double>                       lumped_mass;
     std::vector<types::global_dof_index> dof_indices;
 
-    /** The membrane (0 or 1) of local shape function @p i. */
+    /** The hat function v(j) of local shape function @p j of the FESystem. */
     unsigned int
-    membrane_of(const unsigned int i) const;
+    scalar_index_of(const unsigned int j) const;
 
   private:
     const ProblemData<dim>            &data;
     FEValues<dim>                      fe_values;
     std::vector<unsigned int>          membrane;
-    std::array<std::vector<double>, 2> loads;
+    std::vector<unsigned int>          scalar_index;
+    std::array<std::vector<double>, 2> load_values;
+    Vector<double>                     scalar_lumped_mass;
   };
 } // namespace membranes
 

@@ -17,11 +17,16 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * Field output for ParaView (SPEC §3.4): one VTU file per cycle with u1,
-   * u2, w = u1 − u2, λ_h (the nodal values λ_a), the active set
-   * indicator and, when computed, the error indicator η_K, and a .pvd file that
-   * lists the cycles. Each file is written to a temporary name and renamed, so
-   * that no half-written file is left.
+   * Field output (SPEC §3.4), each file to a temporary name and renamed, so
+   * that no half-written file is left:
+   * - for ParaView (`Write vtu`), one VTU file per cycle with u1, u2,
+   *   w = u1 − u2, λ_h (the nodal values λ_a), the active set indicator
+   *   and, when computed, the error indicator η_K, and a .pvd file that
+   *   lists the cycles;
+   * - for comparisons to round-off (`Write nodal values`), one CSV file
+   *   per cycle, nodal-values-NN.csv, with one row per vertex in the order
+   *   of its u1 DoF: `x,y,u1,u2,lambda_h,active_set`, numbers with 17
+   *   significant digits. (VTU holds single precision values.)
    */
   template <int dim>
   class FieldOutput
@@ -33,10 +38,11 @@ namespace membranes
                 const Discretization<dim> &discretization);
 
     /**
-     * Write cycle @p cycle. @p contact_fields has the layout of the solution
-     * and holds λ_a in the u1 slot and the active set indicator (1 or 0) in
-     * the u2 slot of every vertex; all vectors are ghosted. The error
-     * indicators η_K (one per active cell) are written when given.
+     * Write what the scene asks for of cycle @p cycle. @p contact_fields has
+     * the layout of the solution and holds λ_a in the u1 slot and the active
+     * set indicator (1 or 0) in the u2 slot of every vertex; all vectors are
+     * ghosted. The error indicators η_K (one per active cell) are written to
+     * VTU when given.
      */
     void
     write(const unsigned int     cycle,
@@ -62,6 +68,21 @@ namespace membranes
                 const std::string                           &name,
                 const std::function<void(std::ostream &)>   &writer,
                 std::vector<std::pair<double, std::string>> &written);
+
+    /** solution-NN.vtu and solution.pvd. */
+    void
+    write_vtu(const unsigned int     cycle,
+              const DoFHandler<dim> &dof_handler,
+              const VectorType      &ghosted_solution,
+              const VectorType      &contact_fields,
+              const Vector<double>  *indicators);
+
+    /** nodal-values-NN.csv: position, u1, u2, λ_a, active set per vertex. */
+    void
+    write_nodal_values(const unsigned int     cycle,
+                       const DoFHandler<dim> &dof_handler,
+                       const VectorType      &ghosted_solution,
+                       const VectorType      &contact_fields) const;
 
     const Parameters::Output                   &parameters;
     const Discretization<dim>                  &discretization;

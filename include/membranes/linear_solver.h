@@ -23,7 +23,8 @@ namespace membranes
    * - `direct`: UMFPACK (SuiteSparse) on a copy of the matrix; one process
    *   only.
    * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
-   *   multigrid, with one constant near-null-space mode per membrane.
+   *   multigrid, with one constant near-null-space mode per component of
+   *   the DoFHandler (per membrane for (u1, u2), one for s or w).
    * - `auto`: direct up to direct_solver_dof_limit DoFs on one process,
    *   cg-amg otherwise.
    *

@@ -158,10 +158,11 @@ namespace membranes::Parameters
   /** Subsection `Output`: what a run writes, and where. */
   struct Output
   {
-    std::string directory; ///< Where report.csv and VTU files go.
-    bool        report;    ///< Write report.csv.
-    bool        write_vtu; ///< Write VTU files and a .pvd over cycles.
-    bool        flux_reconstruction; ///< Compute and write the fluxes t_ih.
+    std::string directory;   ///< Where report.csv and VTU files go.
+    bool        report;      ///< Write report.csv.
+    bool        write_vtu;   ///< Write VTU files and a .pvd over cycles.
+    bool write_nodal_values; ///< Write the nodal values as CSV, full precision.
+    bool flux_reconstruction; ///< Compute and write the fluxes t_ih.
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -1,0 +1,70 @@
+#ifndef membranes_coupled_system_h
+#define membranes_coupled_system_h
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <membranes/active_set_system.h>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The linear problem of one active set iteration on the coupled pair
+   * (u1h, u2h), as deal.II's step-41 does it for one field.
+   *
+   * On active vertices the contact constraint u1(a) = u2(a) is a line of an
+   * AffineConstraints object, together with hanging-node constraints and
+   * the boundary values u1 = g_h, u2 = g2_h. Condensing the constraint adds
+   * the equations of u1 and u2 at a, so the solution of each iteration
+   * satisfies Prop. 12 (λ from either membrane) by construction; on
+   * inactive vertices both equations hold, i.e. λ_a = 0. The system is
+   * assembled from CellSystem.
+   */
+  template <int dim>
+  class CoupledSystem : public ActiveSetSystem<dim>
+  {
+  public:
+    using VectorType = typename ActiveSetSystem<dim>::VectorType;
+
+    CoupledSystem(const Parameters::Solver  &parameters,
+                  const Discretization<dim> &discretization,
+                  const ProblemData<dim>    &data,
+                  const MPI_Comm             mpi_communicator);
+
+    /**
+     * Sparsity pattern and matrix for the current mesh; the pattern has room
+     * for any active set.
+     */
+    void
+    setup(const DoFHandler<dim>     &dof_handler,
+          const IndexSet            &locally_owned_dofs,
+          const IndexSet            &locally_relevant_dofs,
+          const DiscreteAction<dim> &action) override;
+
+    /** Nothing: every part of the coupled system depends on the active set. */
+    void
+    prepare(const VectorType    &solution,
+            const double         tolerance,
+            ActiveSetStatistics &statistics) override;
+
+    void
+    solve(const DiscreteAction<dim> &action,
+          const IndexSet            &active_set,
+          VectorType                &solution,
+          const double               tolerance,
+          ActiveSetStatistics       &statistics) override;
+
+  private:
+    /** Hanging-node, contact and boundary constraints for @p active_set. */
+    void
+    make_constraints(const DiscreteAction<dim> &action,
+                     const IndexSet            &active_set);
+
+    SmartPointer<const DoFHandler<dim>> dof_handler;
+    IndexSet                            locally_relevant_dofs;
+    AffineConstraints<double>           constraints;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,146 @@
+#ifndef membranes_decoupled_system_h
+#define membranes_decoupled_system_h
+
+#include <array>
+#include <deal.II/base/function.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <membranes/active_set_system.h>
+#include <memory>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The linear problem of one active set iteration, solved on the sum and
+   * the difference of the membranes (`Solver/Method = decoupled`, SPEC §1).
+   *
+   * <h3>The decoupling of the discrete problem</h3>
+   * Let A be the stiffness matrix of the Laplacian on the scalar P1/Q1
+   * space (condensed with the hanging node constraints), F_i the load
+   * vectors (∫ f_i φ), d_a = ∫ φ_a and Λ_a = λ_a of (4.5). The discrete
+   * problem (3.4) with its multiplier (4.7) reads, at every a ∈ V_h,
+   *
+   *   μ1 (A U1)_a − F1_a = Λ_a d_a,    μ2 (A U2)_a − F2_a = −Λ_a d_a,
+   *   W_a = U1_a − U2_a ≥ 0,   Λ_a ≥ 0,   W_a Λ_a = 0,
+   *
+   * with U1 = g_h, U2 = g2_h on ∂ω. For constant μ1, μ2 (M = μ1 + μ2,
+   * μ̄ = μ1μ2/M) the sum of the two equations and μ̄ times the difference of
+   * the equations divided by μ_i are
+   *
+   *   A S = F1 + F2,                          S = μ1 U1 + μ2 U2,
+   *   μ̄ A W − (μ2 F1 − μ1 F2)/M = Λ d,        W = U1 − U2,
+   *
+   * S = μ1 g_h + μ2 g2_h and W = g_h − g2_h on ∂ω. The first is one linear
+   * problem (−Δs = f1 + f2), the second the scalar obstacle problem
+   * (−μ̄Δw − λ = (μ2 f1 − μ1 f2)/M, w ≥ 0, λ ≥ 0, wλ = 0, step-41 with
+   * obstacle 0) with the same Λ and the same d_a. Conversely
+   *
+   *   U1 = (S + μ2 W)/M,   U2 = (S − μ1 W)/M
+   *
+   * turn any solution (S, W, Λ) back into one of the coupled system: the
+   * decoupling is exact for the discrete problem, not only for (1.1). The
+   * hanging node constraints are linear and homogeneous, so S and W obey
+   * them as U1 and U2 do; the contact constraint lives, as in the coupled
+   * problem, on the unconstrained interior vertices.
+   *
+   * <h3>What one iteration does</h3>
+   * prepare() solves the linear problem for S once per mesh. solve() then
+   * imposes W_a = 0 on the active set (an AffineConstraints line without
+   * entries, merged with the hanging node constraints and W = g_h − g2_h on
+   * ∂ω), solves the obstacle problem's linear system for W (inactive
+   * vertices: Λ_a = 0), and writes U1, U2 into the solution of the
+   * two-component FESystem. ActiveSetSolver computes λ_a by (4.5), the next
+   * active set and the KKT residual from it exactly as for the coupled
+   * system: the test Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the
+   * active set test of this obstacle problem, whose diagonal is μ̄ A_aa.
+   *
+   * Both scalar problems live on one scalar DoFHandler (the base element of
+   * the FESystem, on the same mesh and mapping) and are assembled from the
+   * same cell matrices A_K and loads F_iK as the coupled system
+   * (CellSystem). Each is half the size of the coupled system, and S is
+   * solved only once.
+   */
+  template <int dim>
+  class DecoupledSystem : public ActiveSetSystem<dim>
+  {
+  public:
+    using VectorType = typename ActiveSetSystem<dim>::VectorType;
+
+    DecoupledSystem(const Parameters::Solver  &parameters,
+                    const Discretization<dim> &discretization,
+                    const ProblemData<dim>    &data,
+                    const MPI_Comm             mpi_communicator);
+
+    /**
+     * The scalar DoFHandler on the mesh of @p dof_handler, the map between
+     * its DoFs and those of (u1, u2), the constraints of S, and one sparsity
+     * pattern for S and for W with any active set.
+     */
+    void
+    setup(const DoFHandler<dim>     &dof_handler,
+          const IndexSet            &locally_owned_dofs,
+          const IndexSet            &locally_relevant_dofs,
+          const DiscreteAction<dim> &action) override;
+
+    /**
+     * S and W of the initial guess @p solution; then S of this mesh, from
+     * A S = F1 + F2.
+     */
+    void
+    prepare(const VectorType    &solution,
+            const double         tolerance,
+            ActiveSetStatistics &statistics) override;
+
+    /** W for @p active_set, and (U1, U2) from S and W into @p solution. */
+    void
+    solve(const DiscreteAction<dim> &action,
+          const IndexSet            &active_set,
+          VectorType                &solution,
+          const double               tolerance,
+          ActiveSetStatistics       &statistics) override;
+
+  private:
+    /**
+     * Hanging node constraints, W_a = 0 at the scalar DoFs of the u1 DoFs in
+     * @p active_set, and @p boundary_values on ∂ω, into @p constraints.
+     */
+    void
+    make_constraints(const Function<dim>       &boundary_values,
+                     const IndexSet            &active_set,
+                     AffineConstraints<double> &constraints) const;
+
+    /**
+     * The condensed system of `coefficient · A X = Σ_i load_weights[i] F_i`
+     * for @p constraints.
+     */
+    void
+    assemble_scalar_system(const AffineConstraints<double> &constraints,
+                           const double                     coefficient,
+                           const std::array<double, 2>     &load_weights);
+
+    /** μ1 g + μ2 g2 and g − g2: the boundary values of S and of W. */
+    const std::unique_ptr<Function<dim>> sum_boundary_values;
+    const std::unique_ptr<Function<dim>> difference_boundary_values;
+
+    SmartPointer<const DoFHandler<dim>> dof_handler;
+    DoFHandler<dim>                     scalar_dof_handler;
+    IndexSet                            locally_owned_scalar_dofs;
+    IndexSet                            locally_relevant_scalar_dofs;
+    /** The DoFs of u1 and u2 at the vertex of each scalar DoF. */
+    std::vector<std::array<types::global_dof_index, 2>> membrane_dofs;
+    /** The scalar DoF of each DoF of (u1, u2). */
+    std::vector<types::global_dof_index> scalar_dof;
+
+    AffineConstraints<double> sum_constraints;
+    AffineConstraints<double> difference_constraints;
+
+    /** S = μ1 U1 + μ2 U2 and W = U1 − U2 (locally owned). */
+    VectorType sum;
+    VectorType difference;
+  };
+} // namespace membranes
+
+#endif
