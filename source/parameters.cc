@@ -683,7 +683,8 @@ namespace membranes::Parameters
                       "0",
                       Double(0, 1),
                       "The same share for coarsening, at the small end of "
-                      "the indicators; 0 = no coarsening (quadrilaterals "
+                      "the indicators, with Bulk parameter + Coarsen "
+                      "fraction <= 1; 0 = no coarsening (quadrilaterals "
                       "only: deal.II 9.4 cannot coarsen triangles).");
     prm.declare_entry("Max dofs",
                       "0",
@@ -716,7 +717,12 @@ namespace membranes::Parameters
                           prm.get("Bulk parameter"),
                           "the share must be in (0, 1]");
     coarsen_fraction = get_double(prm, "Refinement", "Coarsen fraction");
-    max_dofs         = prm.get_integer("Max dofs");
+    // Shares of the same cells (or of the same η²), at its two ends.
+    if (bulk_parameter + coarsen_fraction > 1)
+      throw invalid_entry("Refinement/Coarsen fraction",
+                          prm.get("Coarsen fraction"),
+                          "Bulk parameter + Coarsen fraction must be <= 1");
+    max_dofs = prm.get_integer("Max dofs");
     if (prm.get("Estimator") == "flux")
       throw invalid_entry("Refinement/Estimator",
                           "flux",
