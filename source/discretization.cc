@@ -1,3 +1,4 @@
+#include <cmath>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
@@ -6,6 +7,7 @@
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/manifold_lib.h>
+#include <filesystem>
 #include <fstream>
 #include <membranes/discretization.h>
 #include <sstream>
@@ -43,12 +45,105 @@ namespace membranes
 
 
 
+    /**
+     * A Gmsh file announces how many nodes and elements follow, and
+     * GridIn allocates that much before it reads them: reject a count that
+     * the file cannot hold (each item takes more than one byte), so that a
+     * corrupt file cannot make the program allocate gigabytes or read on
+     * for minutes.
+     */
+    void
+    check_announced_sizes(const std::string &file_name)
+    {
+      const auto    size = std::filesystem::file_size(file_name);
+      std::ifstream in(file_name);
+      std::string   header, line;
+      while (std::getline(in, header))
+        if (header.rfind("$", 0) == 0 && header.rfind("$End", 0) != 0 &&
+            std::getline(in, line))
+          {
+            std::istringstream counts(line);
+            double             count;
+            while (counts >> count)
+              if (!(count >= 0 && count <= size))
+                throw Parameters::invalid_entry(
+                  "Geometry/Mesh file",
+                  file_name,
+                  "the counts '" + line.substr(0, 40) + "' after " +
+                    header.substr(0, 40) + " cannot be right in a file of " +
+                    std::to_string(size) + " bytes");
+          }
+    }
+
+
+
+    /**
+     * Check that every cell of a mesh read from a file is a proper one:
+     * coordinates finite and within Parameters::max_magnitude, and, at
+     * every vertex, the two edges through it turn counterclockwise (the
+     * Jacobian of the cell's map is positive there, hence everywhere for
+     * P1 and Q1: no degenerate, inverted or self-intersecting cell).
+     * GridIn has already turned cells given clockwise, as Gmsh writes them
+     * for a surface whose normal points down, counterclockwise.
+     */
+    template <int dim>
+    void
+    check_cells(const std::string &file_name, const Triangulation<dim> &mesh)
+    {
+      for (const auto &cell : mesh.active_cell_iterators())
+        {
+          // The vertices in counterclockwise order: deal.II numbers those
+          // of a quadrilateral lexicographically.
+          const std::vector<unsigned int> order =
+            cell->n_vertices() == 3 ? std::vector<unsigned int>{0, 1, 2} :
+                                      std::vector<unsigned int>{0, 1, 3, 2};
+          const unsigned int n = order.size();
+          for (unsigned int k = 0; k < n; ++k)
+            {
+              const Point<dim> &a = cell->vertex(order[k]);
+              for (unsigned int d = 0; d < dim; ++d)
+                if (!(std::abs(a[d]) <= Parameters::max_magnitude))
+                  {
+                    std::ostringstream allowed;
+                    allowed << "vertex (" << a << ") of cell " << cell->index()
+                            << ": coordinates must be finite and at most "
+                            << Parameters::max_magnitude << " in magnitude";
+                    throw Parameters::invalid_entry("Geometry/Mesh file",
+                                                    file_name,
+                                                    allowed.str());
+                  }
+              const Tensor<1, dim> next = cell->vertex(order[(k + 1) % n]) - a;
+              const Tensor<1, dim> previous =
+                cell->vertex(order[(k + n - 1) % n]) - a;
+              if (!(next[0] * previous[1] - next[1] * previous[0] > 0))
+                {
+                  std::ostringstream allowed;
+                  allowed << "cell " << cell->index() << " is degenerate, "
+                          << "inverted or self-intersecting at its vertex ("
+                          << a << ")";
+                  throw Parameters::invalid_entry("Geometry/Mesh file",
+                                                  file_name,
+                                                  allowed.str());
+                }
+            }
+        }
+    }
+
+
+
     /** Read a Gmsh file, with every failure turned into an InputError. */
     template <int dim>
     void
     read_mesh_file(const std::string  &file_name,
                    Triangulation<dim> &triangulation)
     {
+      if (const std::string problem = Parameters::unreadable_file(file_name);
+          !problem.empty())
+        throw Parameters::invalid_entry("Geometry/Mesh file",
+                                        file_name,
+                                        problem +
+                                          "; expected a Gmsh .msh file");
+      check_announced_sizes(file_name);
       std::ifstream in(file_name);
       if (!in)
         throw Parameters::invalid_entry("Geometry/Mesh file",
@@ -61,25 +156,17 @@ namespace membranes
         }
       catch (const std::exception &e)
         {
-          std::ostringstream reason;
-          if (const auto *dealii_error =
-                dynamic_cast<const ExceptionBase *>(&e))
-            dealii_error->print_info(reason);
-          else
-            reason << e.what();
-          std::string text = reason.str();
-          for (char &c : text)
-            if (c == '\n')
-              c = ' ';
           throw Parameters::invalid_entry("Geometry/Mesh file",
                                           file_name,
                                           "not a readable Gmsh mesh (" +
-                                            Utilities::trim(text) + ")");
+                                            Parameters::one_line_message(e) +
+                                            ")");
         }
       if (triangulation.n_active_cells() == 0)
         throw Parameters::invalid_entry("Geometry/Mesh file",
                                         file_name,
                                         "the mesh has no cells");
+      check_cells(file_name, triangulation);
     }
   } // namespace
 
@@ -158,6 +245,27 @@ namespace membranes
           }
       }
 
+    // Each refinement makes four cells of one: refuse a first mesh that
+    // would not fit in memory before trying to build it.
+    const std::uint64_t max_cells = 1 << 22;
+    const double        cells     = triangulation.n_active_cells() *
+                         std::pow(GeometryInfo<dim>::max_children_per_cell,
+                                  geometry.initial_refinement);
+    if (cells > max_cells)
+      {
+        std::ostringstream allowed;
+        allowed << "the first mesh would have "
+                << static_cast<std::uint64_t>(cells) << " cells ("
+                << triangulation.n_active_cells() << " coarse cells, each "
+                << "refined into " << GeometryInfo<dim>::max_children_per_cell
+                << "^" << geometry.initial_refinement << "); at most "
+                << max_cells
+                << " are allowed, finer meshes come from the cycles";
+        throw Parameters::invalid_entry("Geometry/Initial refinement",
+                                        std::to_string(
+                                          geometry.initial_refinement),
+                                        allowed.str());
+      }
     triangulation.refine_global(geometry.initial_refinement);
   }
 

@@ -1,10 +1,10 @@
 #include <cmath>
-#include <cstdio>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <membranes/atomic_file.h>
 #include <membranes/field_output.h>
 
 namespace membranes
@@ -30,25 +30,6 @@ namespace membranes
             inputs.solution_values[q](0) - inputs.solution_values[q](1);
       }
     };
-
-
-
-    /** Write with @p writer to @p file_name via a temporary file. */
-    template <typename Writer>
-    void
-    write_atomically(const std::string &file_name, const Writer &writer)
-    {
-      const std::string temporary = file_name + ".tmp";
-      {
-        std::ofstream out(temporary);
-        writer(out);
-        if (!out)
-          throw std::runtime_error("Output/Directory: cannot write " +
-                                   temporary);
-      }
-      if (std::rename(temporary.c_str(), file_name.c_str()) != 0)
-        throw std::runtime_error("Output/Directory: cannot write " + file_name);
-    }
   } // namespace
 
 

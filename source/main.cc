@@ -18,7 +18,6 @@
 #include <iostream>
 #include <membranes/membrane_problem.h>
 #include <membranes/parameters.h>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -41,54 +40,6 @@ namespace
     "                             e.g. --set 'Refinement/Cycles=4'\n"
     "\n"
     "Exit status: 0 on success, 1 with a one-line message on any error.\n";
-
-  /** Collapse a multi-line message into one line. */
-  std::string
-  one_line(const std::string &text)
-  {
-    std::istringstream in(text);
-    std::string        word, line;
-    while (in >> word)
-      line += (line.empty() ? "" : " ") + word;
-    return line;
-  }
-
-  std::string
-  message_of(const ExceptionBase &e)
-  {
-    std::ostringstream info;
-    e.print_info(info);
-    return one_line(info.str());
-  }
-
-  /** Apply `Sub/Section/Entry=value` to @p prm. */
-  void
-  set_entry(ParameterHandler &prm, const std::string &assignment)
-  {
-    const auto equal = assignment.find('=');
-    const auto slash = assignment.rfind('/', equal);
-    if (equal == std::string::npos || slash == std::string::npos)
-      throw membranes::Parameters::InputError(
-        "--set '" + assignment + "': expected 'Subsection/Entry=value'");
-    const auto subsections =
-      Utilities::split_string_list(assignment.substr(0, slash), '/');
-    const std::string entry =
-      Utilities::trim(assignment.substr(slash + 1, equal - slash - 1));
-    const std::string value = Utilities::trim(assignment.substr(equal + 1));
-    for (const auto &subsection : subsections)
-      prm.enter_subsection(subsection);
-    try
-      {
-        prm.set(entry, value);
-      }
-    catch (const ExceptionBase &e)
-      {
-        throw membranes::Parameters::InputError("--set '" + assignment +
-                                                "': " + message_of(e));
-      }
-    for (unsigned int i = 0; i < subsections.size(); ++i)
-      prm.leave_subsection();
-  }
 } // namespace
 
 
@@ -141,16 +92,9 @@ main(int argc, char **argv)
       if (scene.empty())
         throw Parameters::InputError("no scene file given (see --help)");
 
-      try
-        {
-          prm.parse_input(scene, "", false, false);
-        }
-      catch (const ExceptionBase &e)
-        {
-          throw Parameters::InputError(scene + ": " + message_of(e));
-        }
+      Parameters::read_scene(prm, scene);
       for (const auto &assignment : assignments)
-        set_entry(prm, assignment);
+        Parameters::set_entry(prm, assignment);
 
       Parameters::All parameters;
       parameters.parse_parameters(prm);
@@ -163,17 +107,18 @@ main(int argc, char **argv)
       MembraneProblem<2> problem(parameters);
       problem.run();
     }
-  catch (const ExceptionBase &e)
-    {
-      if (first_process)
-        std::cerr << "membranes: error: " << e.get_exc_name() << ": "
-                  << message_of(e) << std::endl;
-      return 1;
-    }
   catch (const std::exception &e)
     {
       if (first_process)
-        std::cerr << "membranes: error: " << one_line(e.what()) << std::endl;
+        std::cerr << "membranes: error: " << Parameters::one_line_message(e)
+                  << std::endl;
+      return 1;
+    }
+  catch (...)
+    {
+      // Libraries may throw what is not a std::exception (muparser does).
+      if (first_process)
+        std::cerr << "membranes: error: unexpected exception" << std::endl;
       return 1;
     }
   return 0;

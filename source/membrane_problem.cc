@@ -44,8 +44,9 @@ namespace membranes
 
 
   /**
-   * Created only once the scene has passed every check, so that a scene
-   * with bad data leaves nothing behind.
+   * Created only when the first results are there to be written, so that a
+   * scene whose data fail a check on the first mesh (where every expression
+   * is first evaluated) leaves nothing behind.
    */
   template <int dim>
   void
@@ -58,7 +59,10 @@ namespace membranes
     if (error || !std::filesystem::is_directory(parameters.output.directory))
       throw Parameters::invalid_entry("Output/Directory",
                                       parameters.output.directory,
-                                      "cannot create this directory");
+                                      "cannot create this directory (" +
+                                        (error ? error.message() :
+                                                 "a file of that name exists") +
+                                        ")");
   }
 
 
@@ -401,8 +405,6 @@ namespace membranes
                   << std::endl;
             break;
           }
-        if (cycle == 0)
-          create_output_directory();
         transfer_solution();
         record.time_setup = timer.wall_time();
         record.cells      = triangulation.n_global_active_cells();
@@ -429,6 +431,8 @@ namespace membranes
               << " active set iterations, " << record.active_vertices
               << " active vertices, " << record.wall_time << " s" << std::endl;
 
+        if (cycle == 0)
+          create_output_directory();
         report.add(record);
         output_results(cycle);
         if (cycle + 1 < parameters.refinement.cycles)

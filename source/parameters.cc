@@ -1,5 +1,14 @@
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <deal.II/base/utilities.h>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <membranes/parameters.h>
+#include <optional>
+#include <sstream>
+#include <vector>
 
 namespace membranes::Parameters
 {
@@ -7,14 +16,439 @@ namespace membranes::Parameters
   using dealii::Patterns::Double;
   using dealii::Patterns::Integer;
   using dealii::Patterns::Selection;
+  using dealii::Utilities::trim;
+
+  std::string
+  one_line_message(const std::exception &error)
+  {
+    std::ostringstream text;
+    if (const auto *dealii_error =
+          dynamic_cast<const dealii::ExceptionBase *>(&error))
+      dealii_error->print_info(text);
+    else
+      text << error.what();
+    std::string line;
+    bool        blank = false;
+    for (const char c : text.str())
+      if (std::isspace(static_cast<unsigned char>(c)) ||
+          std::iscntrl(static_cast<unsigned char>(c)))
+        blank = !line.empty();
+      else
+        {
+          if (blank)
+            line += ' ';
+          line += c;
+          blank = false;
+        }
+    return line;
+  }
+
+
+
+  std::string
+  unreadable_file(const std::string &file_name)
+  {
+    std::error_code error;
+    const auto      status = std::filesystem::status(file_name, error);
+    if (status.type() == std::filesystem::file_type::not_found)
+      return "no such file";
+    if (error)
+      return error.message();
+    if (status.type() != std::filesystem::file_type::regular)
+      return "not a regular file";
+    return "";
+  }
+
+
 
   InputError
   invalid_entry(const std::string &entry,
                 const std::string &value,
                 const std::string &allowed)
   {
-    return InputError(entry + " = '" + value + "' is invalid: " + allowed);
+    const std::size_t longest = 200;
+    const std::string shown =
+      value.size() <= longest ? value : value.substr(0, longest) + "...";
+    return InputError(entry + " = '" + shown + "' is invalid: " + allowed);
   }
+
+
+
+  namespace
+  {
+    /** A subsection path, and optionally an entry in it, as `A/B/entry`. */
+    std::string
+    joined(std::vector<std::string> path, const std::string &name = "")
+    {
+      if (!name.empty())
+        path.push_back(name);
+      std::string text;
+      for (const std::string &part : path)
+        text += (text.empty() ? "" : "/") + part;
+      return text;
+    }
+
+    /** `a, b, c` */
+    std::string
+    listed(const std::vector<std::string> &names)
+    {
+      std::string text;
+      for (const std::string &name : names)
+        text += (text.empty() ? "" : ", ") + name;
+      return text;
+    }
+
+    /** One statement of a parameter file, as far as messages need it. */
+    struct Statement
+    {
+      unsigned int             line; ///< Where it starts (1-based).
+      std::vector<std::string> path; ///< The subsections it is in.
+      std::string keyword; ///< set, subsection, end, include, or empty.
+      std::string name;    ///< The entry or subsection it names.
+      std::string value;   ///< The value of a set statement.
+      bool        has_value = false; ///< Whether a set statement has '='.
+      std::string text;              ///< The statement, comment removed.
+    };
+
+    /**
+     * The statements of a parameter file in deal.II's syntax (the way
+     * ParameterHandler::parse_input() reads it): lines ending in '\\' joined
+     * with the next, comments from '#' removed, blank lines skipped, and
+     * each statement with the subsections it is in.
+     */
+    std::vector<Statement>
+    statements_of(std::istream &in)
+    {
+      std::vector<Statement>   statements;
+      std::vector<std::string> path;
+      std::string              line, joined_lines;
+      unsigned int             number = 0, start = 0;
+      while (std::getline(in, line))
+        {
+          ++number;
+          if (joined_lines.empty())
+            start = number;
+          line = trim(line);
+          if (!line.empty() && line.back() == '\\')
+            {
+              joined_lines += line.substr(0, line.size() - 1);
+              continue;
+            }
+          std::string text = joined_lines + line;
+          joined_lines.clear();
+          text = text.substr(0, text.find('#'));
+          std::replace(text.begin(), text.end(), '\t', ' ');
+          text = trim(text);
+          if (text.empty())
+            continue;
+
+          Statement  statement{start, path, "", "", "", false, text};
+          const auto keyword = [&](const std::string &lower) {
+            std::string upper = lower;
+            for (char &c : upper)
+              c = static_cast<char>(std::toupper(c));
+            for (const std::string &word : {lower, upper})
+              if (text.rfind(word + " ", 0) == 0 ||
+                  (lower == "end" && text == word))
+                {
+                  statement.keyword = lower;
+                  return trim(text.substr(word.size()));
+                }
+            return std::string();
+          };
+          for (const std::string word : {"set", "subsection", "end", "include"})
+            {
+              statement.name = keyword(word);
+              if (!statement.keyword.empty())
+                break;
+            }
+          if (statement.keyword == "set")
+            {
+              const auto equal    = statement.name.find('=');
+              statement.has_value = (equal != std::string::npos);
+              if (statement.has_value)
+                {
+                  statement.value = trim(statement.name.substr(equal + 1));
+                  statement.name  = trim(statement.name.substr(0, equal));
+                }
+            }
+          else if (statement.keyword == "subsection")
+            path.push_back(statement.name);
+          else if (statement.keyword == "end" && !path.empty())
+            path.pop_back();
+          statements.push_back(statement);
+        }
+      return statements;
+    }
+
+
+
+    /**
+     * The declared parameters: the entries and the subsections of every
+     * subsection path (`""` for the top level), in declaration order, read
+     * back from what ParameterHandler prints.
+     */
+    struct Declarations
+    {
+      std::map<std::string, std::vector<std::string>> entries, subsections;
+
+      Declarations()
+      {
+        ParameterHandler prm;
+        All::declare_parameters(prm);
+        std::stringstream text;
+        prm.print_parameters(text,
+                             ParameterHandler::OutputStyle(
+                               ParameterHandler::ShortPRM |
+                               ParameterHandler::KeepDeclarationOrder));
+        for (const Statement &statement : statements_of(text))
+          if (statement.keyword == "set")
+            entries[joined(statement.path)].push_back(statement.name);
+          else if (statement.keyword == "subsection")
+            subsections[joined(statement.path)].push_back(statement.name);
+      }
+
+      /** The names in @p kind (entries or subsections) of @p path. */
+      static std::vector<std::string>
+      in(const std::map<std::string, std::vector<std::string>> &kind,
+         const std::vector<std::string>                        &path)
+      {
+        const auto found = kind.find(joined(path));
+        return found == kind.end() ? std::vector<std::string>() : found->second;
+      }
+
+      static bool
+      has(const std::map<std::string, std::vector<std::string>> &kind,
+          const std::vector<std::string>                        &path,
+          const std::string                                     &name)
+      {
+        const auto names = in(kind, path);
+        return std::find(names.begin(), names.end(), name) != names.end();
+      }
+    };
+
+
+
+    /**
+     * The InputError (at @p where) for the first subsection of @p path that
+     * is not declared, if there is one.
+     */
+    std::optional<InputError>
+    undeclared_subsection(const Declarations             &declared,
+                          const std::vector<std::string> &path,
+                          const std::string              &where)
+    {
+      std::vector<std::string> prefix;
+      for (const std::string &subsection : path)
+        {
+          if (!declared.has(declared.subsections, prefix, subsection))
+            {
+              const auto known = declared.in(declared.subsections, prefix);
+              return InputError(
+                where + joined(prefix, subsection) + " is not a subsection: " +
+                (known.empty() ? joined(prefix) + " has no subsections" :
+                                 "the subsections" +
+                                   (prefix.empty() ? std::string() :
+                                                     " of " + joined(prefix)) +
+                                   " are " + listed(known)));
+            }
+          prefix.push_back(subsection);
+        }
+      return std::nullopt;
+    }
+
+
+
+    /**
+     * Why `path/name = value` (at @p where) is not accepted: a subsection of
+     * @p path that is not declared, an entry that is not, or a value that
+     * does not match the entry's pattern (@p reason, deal.II's message, then
+     * says which).
+     */
+    InputError
+    assignment_error(const std::vector<std::string> &path,
+                     const std::string              &name,
+                     const std::string              &value,
+                     const std::string              &where,
+                     const std::string              &reason)
+    {
+      const Declarations declared;
+      if (const auto error = undeclared_subsection(declared, path, where))
+        return *error;
+      if (!declared.has(declared.entries, path, name))
+        return InputError(where + joined(path, name) + " is not a parameter: " +
+                          (path.empty() ?
+                             "entries are set inside the subsections " +
+                               listed(declared.in(declared.subsections, {})) :
+                             "the entries of " + joined(path) + " are " +
+                               listed(declared.in(declared.entries, path))));
+      // The pattern is the end of deal.II's message, as in "... does not
+      // match the given pattern: [Integer range 0...20 (inclusive)]".
+      const auto        at = reason.rfind("pattern");
+      const std::string pattern =
+        at == std::string::npos ? reason : trim(reason.substr(at + 7));
+      const auto first = pattern.find_first_not_of(":< ");
+      const auto last  = pattern.find_last_not_of(">. ");
+      return InputError(
+        where +
+        invalid_entry(joined(path, name),
+                      value,
+                      "expected " + (first == std::string::npos ?
+                                       pattern :
+                                       pattern.substr(first, last - first + 1)))
+          .what());
+    }
+
+
+
+    /**
+     * The InputError for the scene @p file_name, which deal.II rejected with
+     * @p reason: the statement at the line the reason names, read again
+     * here, says which entry or subsection is wrong.
+     */
+    InputError
+    scene_error(const std::string &file_name, const std::string &reason)
+    {
+      std::ifstream in(file_name);
+      const auto    statements = statements_of(in);
+      const auto    at         = reason.find("Line <");
+      if (at == std::string::npos)
+        {
+          // No line: the file ends inside a subsection.
+          std::vector<std::string> open;
+          unsigned int             line = 0;
+          for (const Statement &statement : statements)
+            if (statement.keyword == "subsection")
+              {
+                open = statement.path;
+                open.push_back(statement.name);
+                line = statement.line;
+              }
+            else if (statement.keyword == "end" && !open.empty())
+              open.pop_back();
+          if (open.empty())
+            return InputError(file_name + ": " + reason);
+          return InputError(file_name + ", line " + std::to_string(line) +
+                            ": subsection " + joined(open) +
+                            " has no 'end' before the end of the file");
+        }
+
+      const unsigned int line = std::stoul(reason.substr(at + 6));
+      const std::string  where =
+        file_name + ", line " + std::to_string(line) + ": ";
+      const auto statement =
+        std::find_if(statements.rbegin(),
+                     statements.rend(),
+                     [&](const Statement &s) { return s.line <= line; });
+      if (statement == statements.rend())
+        return InputError(where + reason);
+      const Statement &s = *statement;
+      if (s.keyword == "set" && s.has_value)
+        return assignment_error(s.path, s.name, s.value, where, reason);
+      if (s.keyword == "subsection")
+        {
+          auto path = s.path;
+          path.push_back(s.name);
+          if (const auto error =
+                undeclared_subsection(Declarations(), path, where))
+            return *error;
+        }
+      const std::string context = s.path.empty() ?
+                                    std::string() :
+                                    "in subsection " + joined(s.path) + ": ";
+      if (s.keyword == "end")
+        return InputError(where + "'end' without a subsection to end");
+      if (s.keyword == "include")
+        return InputError(where + context +
+                          reason.substr(reason.find(": ") + 2));
+      return InputError(where + context + "cannot parse '" + s.text +
+                        "': expected 'set Entry = value', 'subsection Name', "
+                        "'end' or 'include file'");
+    }
+  } // namespace
+
+
+
+  void
+  read_scene(ParameterHandler &prm, const std::string &file_name)
+  {
+    if (const std::string problem = unreadable_file(file_name);
+        !problem.empty())
+      throw InputError(file_name + ": " + problem +
+                       "; a scene is a parameter file 'name.prm'");
+    try
+      {
+        prm.parse_input(file_name, "", false, false);
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        throw scene_error(file_name, one_line_message(e));
+      }
+  }
+
+
+
+  void
+  set_entry(ParameterHandler &prm, const std::string &assignment)
+  {
+    const auto        equal = assignment.find('=');
+    const auto        slash = assignment.rfind('/', equal);
+    const std::string entry =
+      slash == std::string::npos ?
+        "" :
+        trim(assignment.substr(slash + 1, equal - slash - 1));
+    if (equal == std::string::npos || entry.empty())
+      throw InputError("--set '" + assignment +
+                       "': expected 'Subsection/Entry=value'");
+    const auto subsections =
+      dealii::Utilities::split_string_list(assignment.substr(0, slash), '/');
+    const std::string value = trim(assignment.substr(equal + 1));
+    const std::string where = "--set '" + assignment + "': ";
+    if (!prm.subsection_path_exists(subsections))
+      throw assignment_error(subsections, entry, value, where, "");
+    for (const auto &subsection : subsections)
+      prm.enter_subsection(subsection);
+    try
+      {
+        prm.set(entry, value);
+      }
+    catch (const dealii::ExceptionBase &e)
+      {
+        throw assignment_error(
+          subsections, entry, value, where, one_line_message(e));
+      }
+    for (unsigned int i = 0; i < subsections.size(); ++i)
+      prm.leave_subsection();
+  }
+
+
+
+  namespace
+  {
+    /**
+     * The number in entry @p entry of the current subsection @p subsection.
+     * The Double pattern lets numbers through that std::strtod then refuses
+     * (below the normal range of double precision, e.g. 1e-308): an
+     * InputError names them.
+     */
+    double
+    get_double(const ParameterHandler &prm,
+               const std::string      &subsection,
+               const std::string      &entry)
+    {
+      try
+        {
+          return prm.get_double(entry);
+        }
+      catch (const dealii::ExceptionBase &)
+        {
+          throw invalid_entry(subsection + "/" + entry,
+                              prm.get(entry),
+                              "not a number of double precision (at least "
+                              "2.3e-308 in magnitude, or 0)");
+        }
+    }
+  } // namespace
 
 
 
@@ -72,8 +506,12 @@ namespace membranes::Parameters
   Problem::declare_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Problem");
-    prm.declare_entry("mu1", "1", Double(), "Tension of membrane 1 (> 0).");
-    prm.declare_entry("mu2", "1", Double(), "Tension of membrane 2 (> 0).");
+    prm.declare_entry("mu1",
+                      "1",
+                      Double(),
+                      "Tension of membrane 1, in [1e-50, 1e50], with "
+                      "mu1/mu2 in [1e-12, 1e12].");
+    prm.declare_entry("mu2", "1", Double(), "Tension of membrane 2, likewise.");
     prm.declare_entry("Function constants",
                       "",
                       dealii::Patterns::Anything(),
@@ -104,13 +542,28 @@ namespace membranes::Parameters
   Problem::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Problem");
-    mu1 = prm.get_double("mu1");
-    mu2 = prm.get_double("mu2");
+    mu1 = get_double(prm, "Problem", "mu1");
+    mu2 = get_double(prm, "Problem", "mu2");
     for (const auto &[name, value] : {std::pair{"mu1", mu1}, {"mu2", mu2}})
-      if (!(value > 0) || !std::isfinite(value))
-        throw invalid_entry(std::string("Problem/") + name,
-                            prm.get(name),
-                            "a tension must be a finite number > 0");
+      if (!(value >= 1 / max_magnitude && value <= max_magnitude))
+        {
+          std::ostringstream allowed;
+          allowed << "a tension must be a number in [" << 1 / max_magnitude
+                  << ", " << max_magnitude << "]";
+          throw invalid_entry(std::string("Problem/") + name,
+                              prm.get(name),
+                              allowed.str());
+        }
+    if (!(mu1 <= max_tension_ratio * mu2 && mu2 <= max_tension_ratio * mu1))
+      {
+        std::ostringstream message;
+        message << "Problem/mu1 = '" << prm.get("mu1")
+                << "' and Problem/mu2 = '" << prm.get("mu2")
+                << "' are invalid: the ratio mu1/mu2 must "
+                << "lie in [" << 1 / max_tension_ratio << ", "
+                << max_tension_ratio << "]";
+        throw InputError(message.str());
+      }
     function_constants = prm.get("Function constants");
     f1                 = prm.get("f1");
     f2                 = prm.get("f2");
@@ -190,7 +643,7 @@ namespace membranes::Parameters
     linear_solver             = (ls == "direct" ? LinearSolverType::direct :
                                  ls == "cg-amg" ? LinearSolverType::cg_amg :
                                                   LinearSolverType::automatic);
-    tolerance                 = prm.get_double("Tolerance");
+    tolerance                 = get_double(prm, "Solver", "Tolerance");
     max_active_set_iterations = prm.get_integer("Max active set iterations");
     prm.leave_subsection();
   }
@@ -227,7 +680,8 @@ namespace membranes::Parameters
                       "0",
                       Double(0, 1),
                       "The same share for coarsening, at the small end of "
-                      "the indicators; 0 = no coarsening (quadrilaterals "
+                      "the indicators, with Bulk parameter + Coarsen "
+                      "fraction <= 1; 0 = no coarsening (quadrilaterals "
                       "only: deal.II 9.4 cannot coarsen triangles).");
     prm.declare_entry("Max dofs",
                       "0",
@@ -257,13 +711,18 @@ namespace membranes::Parameters
     cycles = prm.get_integer("Cycles");
     marking =
       (prm.get("Marking") == "bulk" ? Marking::bulk : Marking::fixed_fraction);
-    bulk_parameter = prm.get_double("Bulk parameter");
+    bulk_parameter = get_double(prm, "Refinement", "Bulk parameter");
     if (!(bulk_parameter > 0))
       throw invalid_entry("Refinement/Bulk parameter",
                           prm.get("Bulk parameter"),
                           "the share must be in (0, 1]");
-    coarsen_fraction = prm.get_double("Coarsen fraction");
-    max_dofs         = prm.get_integer("Max dofs");
+    coarsen_fraction = get_double(prm, "Refinement", "Coarsen fraction");
+    // Shares of the same cells (or of the same η²), at its two ends.
+    if (bulk_parameter + coarsen_fraction > 1)
+      throw invalid_entry("Refinement/Coarsen fraction",
+                          prm.get("Coarsen fraction"),
+                          "Bulk parameter + Coarsen fraction must be <= 1");
+    max_dofs = prm.get_integer("Max dofs");
     estimator =
       (prm.get("Estimator") == "flux" ? Estimator::flux : Estimator::residual);
     prm.leave_subsection();

@@ -1,7 +1,6 @@
 #include <algorithm>
-#include <cstdio>
-#include <fstream>
 #include <iomanip>
+#include <membranes/atomic_file.h>
 #include <membranes/report.h>
 #include <sstream>
 
@@ -123,31 +122,25 @@ namespace membranes
   void
   Report::write_csv() const
   {
-    const std::string file_name = parameters.directory + "/report.csv";
-    const std::string temporary = file_name + ".tmp";
-    {
-      std::ofstream out(temporary);
-      const auto   &names = column_names();
-      for (unsigned int c = 0; c < names.size(); ++c)
-        out << (c == 0 ? "" : ",") << names[c];
-      out << '\n' << std::setprecision(12);
-      for (const CycleRecord &record : records)
-        {
-          const auto values = row_values(record);
-          for (unsigned int c = 0; c < values.size(); ++c)
-            {
-              if (c > 0)
-                out << ',';
-              if (values[c])
-                out << *values[c];
-            }
-          out << '\n';
-        }
-      if (!out)
-        throw std::runtime_error("Output/Directory: cannot write " + temporary);
-    }
-    if (std::rename(temporary.c_str(), file_name.c_str()) != 0)
-      throw std::runtime_error("Output/Directory: cannot write " + file_name);
+    write_atomically(parameters.directory + "/report.csv",
+                     [this](std::ostream &out) {
+                       const auto &names = column_names();
+                       for (unsigned int c = 0; c < names.size(); ++c)
+                         out << (c == 0 ? "" : ",") << names[c];
+                       out << '\n' << std::setprecision(12);
+                       for (const CycleRecord &record : records)
+                         {
+                           const auto values = row_values(record);
+                           for (unsigned int c = 0; c < values.size(); ++c)
+                             {
+                               if (c > 0)
+                                 out << ',';
+                               if (values[c])
+                                 out << *values[c];
+                             }
+                           out << '\n';
+                         }
+                     });
   }
 
 

@@ -26,11 +26,64 @@ namespace membranes::Parameters
     using std::runtime_error::runtime_error;
   };
 
-  /** The InputError for `entry = value`, which should be `allowed`. */
+  /**
+   * The message of @p error on one line: deal.II's description of its
+   * exceptions, or what(); line breaks, control characters and runs of
+   * blanks become one blank.
+   */
+  std::string
+  one_line_message(const std::exception &error);
+
+  /**
+   * The InputError for `entry = value`, which should be `allowed`. A value
+   * longer than a line is shortened in the message.
+   */
   InputError
   invalid_entry(const std::string &entry,
                 const std::string &value,
                 const std::string &allowed);
+
+  /**
+   * Why @p file_name cannot be read as an input file ("no such file", "not
+   * a regular file", ...), or an empty string if it can. Directories,
+   * devices and pipes are refused: they would read as nothing, or never
+   * end (/dev/zero).
+   */
+  std::string
+  unreadable_file(const std::string &file_name);
+
+  /**
+   * The largest magnitude of any number in the data: tensions lie in
+   * [1/max_magnitude, max_magnitude], and every expression and every mesh
+   * coordinate stays within ±max_magnitude where the program evaluates it.
+   * Then no square or product that the program forms from the data (energy,
+   * norms, residuals) overflows double precision.
+   */
+  constexpr double max_magnitude = 1e50;
+
+  /**
+   * The largest ratio μ1/μ2 or μ2/μ1 of the tensions. The active set method
+   * balances forces of both membranes in one system; beyond this ratio the
+   * softer membrane's forces drown in the round-off of the stiffer one's
+   * and the method does not converge (observed from 1e16 on).
+   */
+  constexpr double max_tension_ratio = 1e12;
+
+  /**
+   * Read the scene @p file_name into @p prm. Any error is an InputError
+   * naming where it is (`Subsection/Entry`, or the subsection, and the line)
+   * and what is allowed there: the declared entries or subsections, or the
+   * pattern of the value.
+   */
+  void
+  read_scene(ParameterHandler &prm, const std::string &file_name);
+
+  /**
+   * Apply the command-line assignment `Subsection/Entry=value` to @p prm,
+   * with the same messages as read_scene().
+   */
+  void
+  set_entry(ParameterHandler &prm, const std::string &assignment);
 
   enum class Domain
   {

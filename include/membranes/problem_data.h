@@ -2,7 +2,6 @@
 #define membranes_problem_data_h
 
 #include <deal.II/base/function.h>
-#include <deal.II/base/function_parser.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/grid/tria.h>
 #include <membranes/parameters.h>
@@ -21,7 +20,10 @@ namespace membranes
    * scene's `Function constants` and the names `mu1`, `mu2`, `pi`, so that a
    * manufactured solution written in terms of the tensions stays exact for
    * any μ1, μ2. Expressions are parsed and evaluated once on construction;
-   * one that does not parse is an InputError naming its entry. Gradients of
+   * one that does not parse is an InputError naming its entry. Every value
+   * is checked where the program evaluates it: one that is not finite, or
+   * larger than Parameters::max_magnitude in magnitude, is an InputError
+   * naming the entry and the point. Gradients of
    * the exact solution (for H1 errors) come from central (second-order)
    * finite differences, with a step set by set_gradient_step().
    */
@@ -31,6 +33,8 @@ namespace membranes
   public:
     ProblemData(const Parameters::Problem       &problem,
                 const Parameters::ExactSolution &exact);
+
+    ~ProblemData();
 
     /** Load f_i of membrane i (i = 0 or 1 for membranes 1 and 2). */
     const Function<dim> &
@@ -46,8 +50,9 @@ namespace membranes
 
     /**
      * Check g ≥ 0 and g − g2 ≥ 0 at the boundary vertices of @p triangulation
-     * (where g_h and g2_h interpolate them) and at points along every
-     * boundary face, and that all data are finite there. Throws an
+     * and at points along every boundary face, on the boundary as its
+     * manifold describes it (where the vertices of the finer meshes, at
+     * which g_h and g2_h interpolate g and g2, will lie). Throws an
      * InputError naming `Problem/g` or `Problem/g2` otherwise.
      */
     void
@@ -81,16 +86,17 @@ namespace membranes
     const double mu_bar;
 
   private:
+    class Expression;
     class BoundaryValues;
 
-    std::array<std::unique_ptr<FunctionParser<dim>>, 2> f;
-    std::unique_ptr<FunctionParser<dim>>                g;
-    std::unique_ptr<FunctionParser<dim>>                g2;
-    std::unique_ptr<Function<dim>>                      g_and_g2;
+    std::array<std::unique_ptr<Expression>, 2> f;
+    std::unique_ptr<Expression>                g;
+    std::unique_ptr<Expression>                g2;
+    std::unique_ptr<Function<dim>>             g_and_g2;
 
-    const bool                                          known;
-    std::array<std::unique_ptr<FunctionParser<dim>>, 2> exact_u;
-    std::unique_ptr<FunctionParser<dim>>                exact_action;
+    const bool                                 known;
+    std::array<std::unique_ptr<Expression>, 2> exact_u;
+    std::unique_ptr<Expression>                exact_action;
   };
 } // namespace membranes
 
