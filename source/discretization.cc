@@ -6,7 +6,6 @@
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
-#include <deal.II/grid/manifold_lib.h>
 #include <filesystem>
 #include <fstream>
 #include <membranes/discretization.h>
@@ -231,17 +230,27 @@ namespace membranes
         else
           GridGenerator::convert_hypercube_to_simplex_mesh(to_be_split,
                                                            triangulation);
-        // The split disk keeps its circle: every boundary face follows a
-        // spherical manifold under refinement.
+        // The split disk keeps its circle: the vertices on its boundary
+        // (after a refinement, the new ones in the middle of chords) are
+        // moved onto the unit circle, where a spherical manifold on the
+        // boundary faces would put them. Such a manifold cannot be used:
+        // MappingFE, the mapping of simplices, requires a cell and all its
+        // faces to share one manifold id (a Debug build stops on it), so
+        // the manifolds that the split copied from the disk of
+        // quadrilaterals are removed too.
         if (geometry.domain == Parameters::Domain::disk)
           {
-            // (Triangulation::set_all_manifold_ids_on_boundary() crashes on
-            // simplex meshes in deal.II 9.4: mark the coarse faces one by
-            // one.)
-            for (const auto &face : triangulation.active_face_iterators())
-              if (face->at_boundary())
-                face->set_manifold_id(0);
-            triangulation.set_manifold(0, SphericalManifold<dim>());
+            for (const auto &cell : triangulation.active_cell_iterators())
+              cell->set_all_manifold_ids(numbers::flat_manifold_id);
+            triangulation.reset_all_manifolds();
+            const auto onto_circle = [&triangulation]() {
+              for (const auto &face : triangulation.active_face_iterators())
+                if (face->at_boundary())
+                  for (const unsigned int v : face->vertex_indices())
+                    face->vertex(v) /= face->vertex(v).norm();
+            };
+            onto_circle();
+            triangulation.signals.post_refinement.connect(onto_circle);
           }
       }
 
