@@ -674,7 +674,7 @@ namespace membranes
               }
             equilibrate_chain(
               chain,
-              start == free_end,
+              start != zero_end,
               closed ||
                 links[chain.back().first][1 - chain.back().second] == zero_end);
           }
@@ -686,7 +686,7 @@ namespace membranes
   void
   FluxReconstruction<dim>::equilibrate_chain(
     const std::vector<std::pair<unsigned int, unsigned int>> &chain,
-    const bool                                                starts_free,
+    const bool                                                free_entry,
     const bool                                                closed)
   {
     // With y_j the flux of δ_ih from κ_j into κ_{j+1} (y_0 into κ_1
@@ -732,9 +732,10 @@ namespace membranes
           }
 
         // y_0 minimizes Σ_j ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖²_κj, unless
-        // the chain starts at an edge with a hanging node (y_0 = 0).
+        // the chain starts at an edge with a hanging node (y_0 = 0; if it
+        // ends at one too, γ makes the flux there zero as well).
         double y_0 = 0;
-        if (starts_free || closed)
+        if (free_entry)
           {
             double numerator = 0, denominator = 0;
             for (unsigned int j = 0; j < chain.size(); ++j)
@@ -755,8 +756,6 @@ namespace membranes
               }
             y_0 = -numerator / denominator;
           }
-        if (!starts_free && !closed)
-          y_0 = 0;
         for (unsigned int j = 0; j < chain.size(); ++j)
           {
             SubTriangleData &kappa = sub_triangle_data[chain[j].first];

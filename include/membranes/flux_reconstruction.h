@@ -317,11 +317,15 @@ namespace membranes
     /**
      * σ_ih on one chain of sub-triangles around a vertex, each given with
      * the slot (0: edge 1, 1: edge 2) through which the chain enters it.
+     * @p free_entry: the flux y_0 of δ_ih through the first entry edge is
+     * free (a closed fan, or an end on ∂ω), not zero (an edge with a
+     * hanging node). @p closed: the chain closes up, or ends at an edge with
+     * a hanging node as well, so that a constant γ balances it.
      */
     void
     equilibrate_chain(
       const std::vector<std::pair<unsigned int, unsigned int>> &chain,
-      const bool                                                starts_free,
+      const bool                                                free_entry,
       const bool                                                closed);
     const Discretization<dim>    &discretization;
     const ProblemData<dim>       &data;
