@@ -96,6 +96,31 @@ namespace membranes
 
   template <int dim>
   IndexSet
+  ActiveSetSolver<dim>::locally_relevant_active_set(
+    const DiscreteAction<dim> &action,
+    const IndexSet            &active_set) const
+  {
+    VectorType owned_flags(locally_owned_dofs, mpi_communicator);
+    for (const auto dof : active_set)
+      owned_flags[dof] = 1;
+    owned_flags.compress(VectorOperation::insert);
+    VectorType flags(locally_owned_dofs,
+                     locally_relevant_dofs,
+                     mpi_communicator);
+    flags = owned_flags;
+
+    IndexSet relevant_active_set(dof_handler->n_dofs());
+    for (const auto &dofs : action.locally_relevant_vertices())
+      if (flags[dofs[0]] > 0)
+        relevant_active_set.add_index(dofs[0]);
+    relevant_active_set.compress();
+    return relevant_active_set;
+  }
+
+
+
+  template <int dim>
+  IndexSet
   ActiveSetSolver<dim>::initial_active_set(
     const DiscreteAction<dim> &action,
     const VectorType          &ghosted_solution,
@@ -174,8 +199,11 @@ namespace membranes
 
     for (unsigned int iteration = 1;; ++iteration)
       {
-        system->solve(
-          action, active_set, solution, linear_tolerance(), statistics);
+        system->solve(action,
+                      locally_relevant_active_set(action, active_set),
+                      solution,
+                      linear_tolerance(),
+                      statistics);
 
         timer.restart();
         ghosted_solution = solution;

@@ -51,11 +51,11 @@ namespace membranes
     constraints.reinit(locally_relevant_dofs);
     DoFTools::make_hanging_node_constraints(*dof_handler, constraints);
 
-    for (const auto &a : action.vertices())
-      if (active_set.is_element(a.dof[0]))
+    for (const auto &dofs : action.locally_relevant_vertices())
+      if (active_set.is_element(dofs[0]))
         {
-          constraints.add_line(a.dof[0]);
-          constraints.add_entry(a.dof[0], a.dof[1], 1.0);
+          constraints.add_line(dofs[0]);
+          constraints.add_entry(dofs[0], dofs[1], 1.0);
         }
 
     this->add_boundary_values(*dof_handler,

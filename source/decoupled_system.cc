@@ -59,10 +59,11 @@ namespace membranes
   void
   DecoupledSystem<dim>::setup(const DoFHandler<dim> &dof_handler,
                               const IndexSet &,
-                              const IndexSet &,
+                              const IndexSet &locally_relevant_dofs,
                               const DiscreteAction<dim> &)
   {
-    this->dof_handler = &dof_handler;
+    this->dof_handler           = &dof_handler;
+    this->locally_relevant_dofs = locally_relevant_dofs;
     scalar_dof_handler.reinit(dof_handler.get_triangulation());
     scalar_dof_handler.distribute_dofs(
       this->discretization.fe->base_element(0));
@@ -77,20 +78,25 @@ namespace membranes
     std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
     std::vector<types::global_dof_index> scalar_dof_indices(
       fe.base_element(0).n_dofs_per_cell());
-    membrane_dofs.resize(scalar_dof_handler.n_dofs());
-    scalar_dof.resize(dof_handler.n_dofs());
+    membrane_dofs.resize(locally_owned_scalar_dofs.n_elements());
+    scalar_dof.resize(locally_relevant_dofs.n_elements());
     for (const auto &scalar_cell : scalar_dof_handler.active_cell_iterators())
-      {
-        scalar_cell->get_dof_indices(scalar_dof_indices);
-        cell_of(dof_handler, scalar_cell)->get_dof_indices(dof_indices);
-        for (unsigned int v = 0; v < scalar_dof_indices.size(); ++v)
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              const auto dof = dof_indices[fe.component_to_system_index(i, v)];
-              membrane_dofs[scalar_dof_indices[v]][i] = dof;
-              scalar_dof[dof]                         = scalar_dof_indices[v];
-            }
-      }
+      if (!scalar_cell->is_artificial())
+        {
+          scalar_cell->get_dof_indices(scalar_dof_indices);
+          cell_of(dof_handler, scalar_cell)->get_dof_indices(dof_indices);
+          for (unsigned int v = 0; v < scalar_dof_indices.size(); ++v)
+            for (unsigned int i = 0; i < 2; ++i)
+              {
+                const auto k = scalar_dof_indices[v];
+                const auto dof =
+                  dof_indices[fe.component_to_system_index(i, v)];
+                if (locally_owned_scalar_dofs.is_element(k))
+                  membrane_dofs[locally_owned_scalar_dofs.index_within_set(k)]
+                               [i] = dof;
+                scalar_dof[locally_relevant_dofs.index_within_set(dof)] = k;
+              }
+        }
 
     // W = 0 on active vertices has no entries: the pattern of S, with
     // the hanging node and boundary constraints, holds the matrix of W for
@@ -120,7 +126,8 @@ namespace membranes
     DoFTools::make_hanging_node_constraints(scalar_dof_handler, constraints);
 
     for (const auto dof : active_set)
-      constraints.add_line(scalar_dof[dof]);
+      constraints.add_line(
+        scalar_dof[locally_relevant_dofs.index_within_set(dof)]);
 
     this->add_boundary_values(scalar_dof_handler, boundary_values, constraints);
     constraints.close();
@@ -162,10 +169,11 @@ namespace membranes
   {
     Timer        timer;
     const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    for (const auto k : locally_owned_scalar_dofs)
+    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
       {
-        const double u1 = solution[membrane_dofs[k][0]];
-        const double u2 = solution[membrane_dofs[k][1]];
+        const auto   k  = locally_owned_scalar_dofs.nth_index_in_set(j);
+        const double u1 = solution[membrane_dofs[j][0]];
+        const double u2 = solution[membrane_dofs[j][1]];
         sum[k]          = mu1 * u1 + mu2 * u2;
         difference[k]   = u1 - u2;
       }
@@ -207,10 +215,11 @@ namespace membranes
                               statistics);
 
     timer.restart();
-    for (const auto k : locally_owned_scalar_dofs)
+    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
       {
-        solution[membrane_dofs[k][0]] = (sum[k] + mu2 * difference[k]) / M;
-        solution[membrane_dofs[k][1]] = (sum[k] - mu1 * difference[k]) / M;
+        const auto k = locally_owned_scalar_dofs.nth_index_in_set(j);
+        solution[membrane_dofs[j][0]] = (sum[k] + mu2 * difference[k]) / M;
+        solution[membrane_dofs[j][1]] = (sum[k] - mu1 * difference[k]) / M;
       }
     solution.compress(VectorOperation::insert);
     statistics.solve_time += timer.wall_time();

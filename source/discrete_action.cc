@@ -42,8 +42,6 @@ namespace membranes
     CellSystem<dim>    cell_system(discretization, data);
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     Vector<double>     local_stiffness(dofs_per_cell);
-    std::vector<std::array<types::global_dof_index, 2>> candidates;
-
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
@@ -58,30 +56,37 @@ namespace membranes
             cell_system.dof_indices,
             dual_cell_measure);
           stiffness_diagonal.add(cell_system.dof_indices, local_stiffness);
-
-          for (const unsigned int v : cell->vertex_indices())
-            candidates.push_back(
-              {{cell_system.dof_indices[fe.component_to_system_index(0, v)],
-                cell_system.dof_indices[fe.component_to_system_index(1, v)]}});
         }
     dual_cell_measure.compress(VectorOperation::add);
     stiffness_diagonal.compress(VectorOperation::add);
 
-    // V_h: owned, interior, unconstrained vertices, each once.
+    // The interior vertices of the owned and ghost cells, each once, by
+    // their DoFs (u1, u2).
+    std::vector<std::array<types::global_dof_index, 2>> candidates;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial())
+        for (const unsigned int v : cell->vertex_indices())
+          if (!boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
+            candidates.push_back(
+              {{cell->vertex_dof_index(v, 0), cell->vertex_dof_index(v, 1)}});
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()),
                      candidates.end());
+
+    // V_h: the unconstrained ones; its owned vertices carry λ_a.
     interior_vertices.clear();
+    relevant_vertices.clear();
     interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
     for (const auto &dofs : candidates)
-      if (locally_owned_dofs.is_element(dofs[0]) &&
-          !boundary_dofs.is_element(dofs[0]))
-        {
-          interior_vertex_dofs.add_index(dofs[0]);
-          if (!hanging_node_constraints.is_constrained(dofs[0]))
-            interior_vertices.push_back(
-              {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
-        }
+      {
+        interior_vertex_dofs.add_index(dofs[0]);
+        if (hanging_node_constraints.is_constrained(dofs[0]))
+          continue;
+        relevant_vertices.push_back(dofs);
+        if (locally_owned_dofs.is_element(dofs[0]))
+          interior_vertices.push_back(
+            {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
+      }
     interior_vertex_dofs.compress();
 
     for (unsigned int i = 0; i < 2; ++i)
@@ -159,6 +164,15 @@ namespace membranes
   DiscreteAction<dim>::vertices() const
   {
     return interior_vertices;
+  }
+
+
+
+  template <int dim>
+  const std::vector<std::array<types::global_dof_index, 2>> &
+  DiscreteAction<dim>::locally_relevant_vertices() const
+  {
+    return relevant_vertices;
   }
 
 

@@ -1,5 +1,6 @@
 #include <cmath>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/mapping_fe.h>
@@ -182,6 +183,29 @@ namespace membranes
 
 
   template <int dim>
+  std::unique_ptr<Triangulation<dim>>
+  make_triangulation(const Parameters::CellType cell_type,
+                     const MPI_Comm             mpi_communicator)
+  {
+    if (cell_type == Parameters::CellType::quadrilateral)
+      return std::make_unique<parallel::distributed::Triangulation<dim>>(
+        mpi_communicator);
+    const unsigned int n_processes =
+      Utilities::MPI::n_mpi_processes(mpi_communicator);
+    if (n_processes > 1)
+      throw Parameters::invalid_entry(
+        "Geometry/Cell type",
+        "triangle",
+        "triangle meshes run on one process only (deal.II 9.4's p4est "
+        "triangulation has no simplices), not on " +
+          std::to_string(n_processes) +
+          ": run with one process, or use 'Cell type = quadrilateral'");
+    return std::make_unique<Triangulation<dim>>();
+  }
+
+
+
+  template <int dim>
   void
   create_mesh(const Parameters::Geometry &geometry,
               Triangulation<dim>         &triangulation)
@@ -192,9 +216,12 @@ namespace membranes
     // The coarse mesh, as deal.II makes it (quadrilaterals) or as the file
     // has it. It is built in place unless it has to be split into
     // triangles, so that manifolds tied to it (the disk's transfinite
-    // interior) stay valid.
-    Triangulation<dim>  to_be_split;
-    Triangulation<dim> &coarse = want_triangles ? to_be_split : triangulation;
+    // interior) stay valid; a file is read into a serial triangulation
+    // first, because it may hold triangles, which p4est cannot take.
+    const bool from_file = (geometry.domain == Parameters::Domain::file);
+    Triangulation<dim>  serial_coarse;
+    Triangulation<dim> &coarse =
+      (want_triangles || from_file) ? serial_coarse : triangulation;
     switch (geometry.domain)
       {
         case Parameters::Domain::square:
@@ -223,12 +250,14 @@ namespace membranes
         "quadrilateral",
         "the mesh file holds triangles: use 'Cell type = triangle'");
 
+    if (!want_triangles && from_file)
+      triangulation.copy_triangulation(serial_coarse);
     if (want_triangles)
       {
         if (has_triangles)
-          triangulation.copy_triangulation(to_be_split);
+          triangulation.copy_triangulation(serial_coarse);
         else
-          GridGenerator::convert_hypercube_to_simplex_mesh(to_be_split,
+          GridGenerator::convert_hypercube_to_simplex_mesh(serial_coarse,
                                                            triangulation);
         // The split disk keeps its circle: the vertices on its boundary
         // (after a refinement, the new ones in the middle of chords) are
@@ -257,7 +286,7 @@ namespace membranes
     // Each refinement makes four cells of one: refuse a first mesh that
     // would not fit in memory before trying to build it.
     const std::uint64_t max_cells = 1 << 22;
-    const double        cells     = triangulation.n_active_cells() *
+    const double        cells     = triangulation.n_global_active_cells() *
                          std::pow(GeometryInfo<dim>::max_children_per_cell,
                                   geometry.initial_refinement);
     if (cells > max_cells)
@@ -265,7 +294,8 @@ namespace membranes
         std::ostringstream allowed;
         allowed << "the first mesh would have "
                 << static_cast<std::uint64_t>(cells) << " cells ("
-                << triangulation.n_active_cells() << " coarse cells, each "
+                << triangulation.n_global_active_cells()
+                << " coarse cells, each "
                 << "refined into " << GeometryInfo<dim>::max_children_per_cell
                 << "^" << geometry.initial_refinement << "); at most "
                 << max_cells
@@ -281,6 +311,8 @@ namespace membranes
 
 
   template class Discretization<2>;
+  template std::unique_ptr<Triangulation<2>>
+  make_triangulation<2>(const Parameters::CellType, const MPI_Comm);
   template void
   create_mesh<2>(const Parameters::Geometry &, Triangulation<2> &);
 } // namespace membranes

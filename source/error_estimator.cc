@@ -248,15 +248,17 @@ namespace membranes
 
     // Every interior edge once, from its finer side (or from the cell with
     // the smaller index between cells of the same level); half of the
-    // term goes to each of the two cells.
+    // term goes to each of the two cells. Ghost cells take part, so that an
+    // edge between an owned and a ghost cell counts whichever side
+    // computes it (ghost cells' indicators are dropped later).
     for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
+      if (!cell->is_artificial())
         for (const unsigned int f : cell->face_indices())
           {
             if (cell->at_boundary(f))
               continue;
             const auto &neighbor = cell->neighbor(f);
-            if (neighbor->has_children() ||
+            if (neighbor->has_children() || neighbor->is_artificial() ||
                 (!cell->neighbor_is_coarser(f) &&
                  neighbor->active_cell_index() < cell->active_cell_index()))
               continue;

@@ -1,4 +1,7 @@
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <deal.II/base/mpi.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
 #include <fstream>
@@ -36,9 +39,11 @@ namespace membranes
 
   template <int dim>
   FieldOutput<dim>::FieldOutput(const Parameters::Output  &parameters,
-                                const Discretization<dim> &discretization)
+                                const Discretization<dim> &discretization,
+                                const MPI_Comm             mpi_communicator)
     : parameters(parameters)
     , discretization(discretization)
+    , mpi_communicator(mpi_communicator)
   {}
 
 
@@ -77,6 +82,11 @@ namespace membranes
     data_out.add_data_vector(contact_fields,
                              std::vector<std::string>{"lambda_h",
                                                       "active_set"});
+    const auto   &triangulation = dof_handler.get_triangulation();
+    Vector<float> subdomain(triangulation.n_active_cells());
+    for (float &value : subdomain)
+      value = triangulation.locally_owned_subdomain();
+    data_out.add_data_vector(subdomain, "subdomain");
     Vector<double> eta_K;
     if (indicators)
       {
@@ -92,6 +102,9 @@ namespace membranes
       cycle,
       "solution",
       [&](std::ostream &out) { data_out.write_vtu(out); },
+      [&](std::ostream &out, const std::vector<std::string> &pieces) {
+        data_out.write_pvtu_record(out, pieces);
+      },
       cycles_written);
   }
 
@@ -111,6 +124,10 @@ namespace membranes
         DataOutBase::write_vtu(
           patches, names, {}, DataOutBase::VtkFlags(), out);
       },
+      [&](std::ostream &out, const std::vector<std::string> &pieces) {
+        DataOutBase::write_pvtu_record(
+          out, pieces, names, {}, DataOutBase::VtkFlags());
+      },
       dual_mesh_cycles_written);
   }
 
@@ -119,19 +136,45 @@ namespace membranes
   template <int dim>
   void
   FieldOutput<dim>::write_cycle(
-    const unsigned int                           cycle,
-    const std::string                           &name,
-    const std::function<void(std::ostream &)>   &writer,
+    const unsigned int                         cycle,
+    const std::string                         &name,
+    const std::function<void(std::ostream &)> &write_piece,
+    const std::function<void(std::ostream &, const std::vector<std::string> &)>
+                                                &write_record,
     std::vector<std::pair<double, std::string>> &written)
   {
-    const std::string file_name =
-      name + "-" + Utilities::int_to_string(cycle, 2) + ".vtu";
-    write_atomically(parameters.directory + "/" + file_name, writer);
+    const unsigned int n_processes =
+      Utilities::MPI::n_mpi_processes(mpi_communicator);
+    const unsigned int process =
+      Utilities::MPI::this_mpi_process(mpi_communicator);
+    const std::string base = name + "-" + Utilities::int_to_string(cycle, 2);
+    const auto        piece_name = [&](const unsigned int p) {
+      return n_processes == 1 ?
+                      base + ".vtu" :
+                      base + "." + Utilities::int_to_string(p, 4) + ".vtu";
+    };
+    write_atomically(parameters.directory + "/" + piece_name(process),
+                     write_piece);
+
+    std::string file_name = piece_name(0);
+    if (n_processes > 1)
+      {
+        file_name = base + ".pvtu";
+        std::vector<std::string> pieces;
+        for (unsigned int p = 0; p < n_processes; ++p)
+          pieces.push_back(piece_name(p));
+        if (process == 0)
+          write_atomically(parameters.directory + "/" + file_name,
+                           [&](std::ostream &out) {
+                             write_record(out, pieces);
+                           });
+      }
     written.emplace_back(cycle, file_name);
-    write_atomically(parameters.directory + "/" + name + ".pvd",
-                     [&](std::ostream &out) {
-                       DataOutBase::write_pvd_record(out, written);
-                     });
+    if (process == 0)
+      write_atomically(parameters.directory + "/" + name + ".pvd",
+                       [&](std::ostream &out) {
+                         DataOutBase::write_pvd_record(out, written);
+                       });
   }
 
 
@@ -143,34 +186,45 @@ namespace membranes
                                        const VectorType      &ghosted_solution,
                                        const VectorType &contact_fields) const
   {
-    // Every vertex once, by its u1 DoF: its position and its u2 DoF.
-    const FiniteElement<dim>            &fe = dof_handler.get_fe();
-    std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
-    std::map<types::global_dof_index,
-             std::pair<Point<dim>, types::global_dof_index>>
-      vertices;
+    // The locally owned vertices, each once (by its u1 DoF), with their
+    // values: x, y, u1, u2, λ_a, active set.
+    using Row                 = std::array<double, 6>;
+    const IndexSet owned_dofs = ghosted_solution.locally_owned_elements();
+    std::map<types::global_dof_index, Row> owned_rows;
     for (const auto &cell : dof_handler.active_cell_iterators())
-      {
-        cell->get_dof_indices(dof_indices);
+      if (cell->is_locally_owned())
         for (const unsigned int v : cell->vertex_indices())
-          vertices.emplace(
-            dof_indices[fe.component_to_system_index(0, v)],
-            std::make_pair(cell->vertex(v),
-                           dof_indices[fe.component_to_system_index(1, v)]));
-      }
+          {
+            const auto u1_dof = cell->vertex_dof_index(v, 0);
+            const auto u2_dof = cell->vertex_dof_index(v, 1);
+            if (owned_dofs.is_element(u1_dof))
+              owned_rows[u1_dof] = {{cell->vertex(v)[0],
+                                     cell->vertex(v)[1],
+                                     ghosted_solution[u1_dof],
+                                     ghosted_solution[u2_dof],
+                                     contact_fields[u1_dof],
+                                     contact_fields[u2_dof]}};
+          }
+    std::vector<Row> rows;
+    for (const auto &[dof, row] : owned_rows)
+      rows.push_back(row);
+
+    // All of them on the first process, in the order of their positions.
+    const auto gathered = Utilities::MPI::gather(mpi_communicator, rows, 0);
+    if (Utilities::MPI::this_mpi_process(mpi_communicator) != 0)
+      return;
+    rows.clear();
+    for (const auto &process_rows : gathered)
+      rows.insert(rows.end(), process_rows.begin(), process_rows.end());
+    std::sort(rows.begin(), rows.end());
 
     const std::string name = parameters.directory + "/nodal-values-" +
                              Utilities::int_to_string(cycle, 2) + ".csv";
     write_atomically(name, [&](std::ostream &out) {
       out << std::setprecision(17) << "x,y,u1,u2,lambda_h,active_set\n";
-      for (const auto &[u1_dof, vertex] : vertices)
-        {
-          const auto &[point, u2_dof] = vertex;
-          out << point[0] << ',' << point[1] << ',' << ghosted_solution[u1_dof]
-              << ',' << ghosted_solution[u2_dof] << ','
-              << contact_fields[u1_dof] << ',' << contact_fields[u2_dof]
-              << '\n';
-        }
+      for (const auto &row : rows)
+        out << row[0] << ',' << row[1] << ',' << row[2] << ',' << row[3] << ','
+            << row[4] << ',' << row[5] << '\n';
     });
   }
 

@@ -2,7 +2,9 @@
 #include <cmath>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_tools.h>
 #include <membranes/flux_reconstruction.h>
 #include <unordered_map>
 
@@ -349,8 +351,13 @@ namespace membranes
     std::vector<double> hat_integrals(n_cells *
                                       GeometryInfo<dim>::vertices_per_cell);
 
+    // The owned and the ghost cells: every half-edge and every fan around a
+    // vertex of an owned cell lies in them, so the local rules below give
+    // the owned cells the same fluxes as on one process, without
+    // communication. (At the outer rim of the ghost layer, groups and fans
+    // are cut short by artificial cells; they belong to no owned cell.)
     for (const auto &cell : dof_handler->active_cell_iterators())
-      if (cell->is_locally_owned())
+      if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
           for (unsigned int i = 0; i < 2; ++i)
@@ -511,6 +518,33 @@ namespace membranes
             links[id][1] =
               members[group][0] == id ? members[group][1] : members[group][0];
         }
+
+    // The flux density on an edge with a hanging node is a mean over the
+    // three cells along the whole coarse edge, and a ghost cell may lack
+    // one of them (outside the ghost layer), while the fan of a vertex of
+    // an owned cell may pass through that ghost cell. Every owner has the
+    // whole neighbourhood of its cells: it sends their half-edge fluxes to
+    // the ghost copies.
+    if (dynamic_cast<const parallel::TriangulationBase<dim> *>(
+          &dof_handler->get_triangulation()))
+      GridTools::exchange_cell_data_to_ghosts<std::vector<double>,
+                                              DoFHandler<dim>>(
+        *dof_handler,
+        [&](const CellIterator &cell) {
+          std::vector<double> half_edge_fluxes;
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            for (unsigned int i = 0; i < 2; ++i)
+              half_edge_fluxes.push_back(
+                sub_triangle_data[cell->active_cell_index() * n_triangles + s]
+                  .fluxes[i][2]);
+          return std::optional<std::vector<double>>(half_edge_fluxes);
+        },
+        [&](const CellIterator &cell, const std::vector<double> &in) {
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            for (unsigned int i = 0; i < 2; ++i)
+              sub_triangle_data[cell->active_cell_index() * n_triangles + s]
+                .fluxes[i][2] = in[2 * s + i];
+        });
 
     equilibrate();
 

@@ -40,6 +40,9 @@ namespace
     "  -s, --set 'Sub/Entry=val'  override one entry after reading the scene,\n"
     "                             e.g. --set 'Refinement/Cycles=4'\n"
     "\n"
+    "Run on N processes with 'mpirun -np N membranes scene.prm'\n"
+    "(quadrilateral meshes; triangle meshes run on one process).\n"
+    "\n"
     "Exit status: 0 on success, 1 with a one-line message on any error.\n";
 } // namespace
 
@@ -56,8 +59,14 @@ main(int argc, char **argv)
   // otherwise.
   deal_II_exceptions::disable_abort_on_exception();
   Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv, 1);
-  const bool                       first_process =
-    (Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0);
+  const unsigned int process = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
+  const bool         first_process = (process == 0);
+  const unsigned int n_processes =
+    Utilities::MPI::n_mpi_processes(MPI_COMM_WORLD);
+  // Up to the start of the run every process reads the same input and
+  // fails in the same way; in the run, one process may fail alone (a load
+  // that is NaN on its cells), and the others must not wait for it.
+  bool running = false;
 
   try
     {
@@ -112,10 +121,18 @@ main(int argc, char **argv)
           (std::filesystem::path(scene).parent_path() / mesh_file).string();
 
       MembraneProblem<2> problem(parameters);
+      running = true;
       problem.run();
     }
   catch (const std::exception &e)
     {
+      if (running && n_processes > 1)
+        {
+          std::cerr << "membranes: error (process " << process << " of "
+                    << n_processes << "): " << Parameters::one_line_message(e)
+                    << std::endl;
+          MPI_Abort(MPI_COMM_WORLD, 1);
+        }
       if (first_process)
         std::cerr << "membranes: error: " << Parameters::one_line_message(e)
                   << std::endl;

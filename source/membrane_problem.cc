@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
+#include <deal.II/distributed/grid_refinement.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_refinement.h>
 #include <filesystem>
@@ -16,7 +17,9 @@ namespace membranes
     , pcout(std::cout, Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
     , data(parameters.problem, parameters.exact_solution)
     , discretization(parameters.geometry.cell_type)
-    , dof_handler(triangulation)
+    , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
+                                            mpi_communicator))
+    , dof_handler(*triangulation)
     , action(discretization, data)
     , active_set_solver(parameters.solver,
                         discretization,
@@ -27,7 +30,7 @@ namespace membranes
     , flux_reconstruction(discretization, data)
     , error_estimator(discretization, data)
     , report(parameters.output, pcout)
-    , field_output(parameters.output, discretization)
+    , field_output(parameters.output, discretization, mpi_communicator)
   {}
 
 
@@ -37,8 +40,8 @@ namespace membranes
   void
   MembraneProblem<dim>::make_grid()
   {
-    create_mesh(parameters.geometry, triangulation);
-    data.check_boundary_data(triangulation);
+    create_mesh(parameters.geometry, *triangulation);
+    data.check_boundary_data(*triangulation);
   }
 
 
@@ -52,17 +55,21 @@ namespace membranes
   void
   MembraneProblem<dim>::create_output_directory() const
   {
-    if (!pcout.is_active())
-      return;
-    std::error_code error;
-    std::filesystem::create_directories(parameters.output.directory, error);
-    if (error || !std::filesystem::is_directory(parameters.output.directory))
-      throw Parameters::invalid_entry("Output/Directory",
-                                      parameters.output.directory,
-                                      "cannot create this directory (" +
-                                        (error ? error.message() :
-                                                 "a file of that name exists") +
-                                        ")");
+    if (pcout.is_active())
+      {
+        std::error_code error;
+        std::filesystem::create_directories(parameters.output.directory, error);
+        if (error ||
+            !std::filesystem::is_directory(parameters.output.directory))
+          throw Parameters::invalid_entry(
+            "Output/Directory",
+            parameters.output.directory,
+            "cannot create this directory (" +
+              (error ? error.message() : "a file of that name exists") + ")");
+      }
+    // The other processes write their own pieces into it.
+    const int ierr = MPI_Barrier(mpi_communicator);
+    AssertThrowMPI(ierr);
   }
 
 
@@ -114,7 +121,7 @@ namespace membranes
   void
   MembraneProblem<dim>::transfer_solution()
   {
-    if (!solution_transfer)
+    if (previous_mesh_vectors.empty())
       {
         solution   = 0;
         active_set = IndexSet(dof_handler.n_dofs());
@@ -124,8 +131,15 @@ namespace membranes
     std::vector<VectorType> interpolated(2,
                                          VectorType(locally_owned_dofs,
                                                     mpi_communicator));
-    solution_transfer->interpolate(previous_mesh_vectors, interpolated);
-    solution_transfer.reset();
+    if (distributed_transfer)
+      {
+        std::vector<VectorType *> targets{&interpolated[0], &interpolated[1]};
+        distributed_transfer->interpolate(targets);
+      }
+    else
+      serial_transfer->interpolate(previous_mesh_vectors, interpolated);
+    distributed_transfer.reset();
+    serial_transfer.reset();
     previous_mesh_vectors.clear();
 
     for (auto &vector : interpolated)
@@ -352,28 +366,59 @@ namespace membranes
   MembraneProblem<dim>::refine_grid()
   {
     const auto &refinement = parameters.refinement;
+    auto *const distributed_triangulation =
+      dynamic_cast<parallel::distributed::Triangulation<dim> *>(
+        triangulation.get());
     if (refinement.strategy == Parameters::RefinementStrategy::global)
-      triangulation.set_all_refine_flags();
+      triangulation->set_all_refine_flags();
+    else if (distributed_triangulation)
+      {
+        // The same marking over the cells of all processes: the thresholds
+        // are found by a global bisection instead of a global sort.
+        if (refinement.marking == Parameters::Marking::bulk)
+          parallel::distributed::GridRefinement::
+            refine_and_coarsen_fixed_fraction(*distributed_triangulation,
+                                              indicators,
+                                              refinement.bulk_parameter,
+                                              refinement.coarsen_fraction);
+        else
+          parallel::distributed::GridRefinement::
+            refine_and_coarsen_fixed_number(*distributed_triangulation,
+                                            indicators,
+                                            refinement.bulk_parameter,
+                                            refinement.coarsen_fraction);
+      }
     else if (refinement.marking == Parameters::Marking::bulk)
       GridRefinement::refine_and_coarsen_fixed_fraction(
-        triangulation,
+        *triangulation,
         indicators,
         refinement.bulk_parameter,
         refinement.coarsen_fraction);
     else
       GridRefinement::refine_and_coarsen_fixed_number(
-        triangulation,
+        *triangulation,
         indicators,
         refinement.bulk_parameter,
         refinement.coarsen_fraction);
-    triangulation.prepare_coarsening_and_refinement();
+    triangulation->prepare_coarsening_and_refinement();
 
     previous_mesh_vectors = {ghosted_solution, lambda_h};
-    solution_transfer =
-      std::make_unique<SolutionTransfer<dim, VectorType>>(dof_handler);
-    solution_transfer->prepare_for_coarsening_and_refinement(
-      previous_mesh_vectors);
-    triangulation.execute_coarsening_and_refinement();
+    if (distributed_triangulation)
+      {
+        distributed_transfer = std::make_unique<
+          parallel::distributed::SolutionTransfer<dim, VectorType>>(
+          dof_handler);
+        distributed_transfer->prepare_for_coarsening_and_refinement(
+          {&previous_mesh_vectors[0], &previous_mesh_vectors[1]});
+      }
+    else
+      {
+        serial_transfer =
+          std::make_unique<SolutionTransfer<dim, VectorType>>(dof_handler);
+        serial_transfer->prepare_for_coarsening_and_refinement(
+          previous_mesh_vectors);
+      }
+    triangulation->execute_coarsening_and_refinement();
   }
 
 
@@ -407,10 +452,14 @@ namespace membranes
           }
         transfer_solution();
         record.time_setup = timer.wall_time();
-        record.cells      = triangulation.n_global_active_cells();
+        record.cells      = triangulation->n_global_active_cells();
         record.dofs       = dof_handler.n_dofs();
         pcout << "Cycle " << cycle << ": " << record.cells << " cells, "
-              << record.dofs << " DoFs" << std::endl;
+              << record.dofs << " DoFs";
+        if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
+          pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
+                << " processes";
+        pcout << std::endl;
 
         solve();
 
@@ -427,6 +476,11 @@ namespace membranes
                            (record.time_flux ? *record.time_flux : 0.);
         cumulative_time += record.wall_time;
         record.cumulative_wall_time = cumulative_time;
+        Utilities::System::MemoryStats memory;
+        Utilities::System::get_memory_stats(memory);
+        record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
+        record.memory_mb =
+          Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
         pcout << "   " << record.active_set_iterations
               << " active set iterations, " << record.active_vertices
               << " active vertices, " << record.wall_time << " s" << std::endl;

@@ -45,7 +45,9 @@ namespace membranes
               r.measure_defect,
               r.conservation_defect,
               r.balance_defect,
-              r.time_flux};
+              r.time_flux,
+              r.processes,
+              r.memory_mb};
     }
 
     /** Columns that hold whole numbers. */
@@ -55,7 +57,7 @@ namespace membranes
       return column == "cycle" || column == "cells" || column == "dofs" ||
              column == "active_set_iterations" || column == "active_vertices" ||
              column == "linear_iterations" ||
-             column == "hanging_active_vertices";
+             column == "hanging_active_vertices" || column == "processes";
     }
   } // namespace
 
@@ -96,7 +98,9 @@ namespace membranes
                                                 "measure_defect",
                                                 "conservation_defect",
                                                 "balance_defect",
-                                                "time_flux_s"};
+                                                "time_flux_s",
+                                                "processes",
+                                                "memory_mb"};
     return names;
   }
 

@@ -97,6 +97,16 @@ namespace membranes
 
   private:
     /**
+     * @p active_set (owned vertices) extended to the locally relevant
+     * vertices of @p action by a ghost exchange: the owner of each vertex
+     * decides, every process that shares a cell with it learns the
+     * decision.
+     */
+    IndexSet
+    locally_relevant_active_set(const DiscreteAction<dim> &action,
+                                const IndexSet            &active_set) const;
+
+    /**
      * {a : Λ_a − c_a W_a > 0} for the iterate @p ghosted_solution, with
      * Λ_a = @p lambda(k) for the k-th vertex of @p action.
      */

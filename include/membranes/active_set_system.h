@@ -82,7 +82,9 @@ namespace membranes
 
     /**
      * Solve the linear problem for @p active_set (u1 DoFs of the active
-     * vertices of @p action), starting from @p solution, with a residual
+     * locally relevant vertices of @p action, so that every process knows
+     * the constraints of the cells it assembles), starting from
+     * @p solution, with a residual
      * norm of at most @p tolerance. On return @p solution holds (u1h, u2h),
      * constraints included.
      */

@@ -129,9 +129,17 @@ namespace membranes
     DoFHandler<dim>                     scalar_dof_handler;
     IndexSet                            locally_owned_scalar_dofs;
     IndexSet                            locally_relevant_scalar_dofs;
-    /** The DoFs of u1 and u2 at the vertex of each scalar DoF. */
+    IndexSet                            locally_relevant_dofs;
+    /**
+     * The DoFs of u1 and u2 at the vertex of each locally owned scalar DoF,
+     * by its position in locally_owned_scalar_dofs. (A vertex has the same
+     * owner in both DoFHandlers: the same rule on the same mesh.)
+     */
     std::vector<std::array<types::global_dof_index, 2>> membrane_dofs;
-    /** The scalar DoF of each DoF of (u1, u2). */
+    /**
+     * The scalar DoF of each locally relevant DoF of (u1, u2), by its
+     * position in locally_relevant_dofs.
+     */
     std::vector<types::global_dof_index> scalar_dof;
 
     AffineConstraints<double> sum_constraints;

@@ -34,7 +34,9 @@ namespace membranes
    * λ_a d_a is the residual of membrane 1's equation at a.
    *
    * Everything is stored for the locally owned vertices of V_h only, in the
-   * order of their u1 DoF index.
+   * order of their u1 DoF index; the DoFs of the locally relevant vertices
+   * (those of the ghost cells too) are known for the constraints and for
+   * λ_h on ghost cells.
    */
   template <int dim>
   class DiscreteAction
@@ -75,7 +77,16 @@ namespace membranes
     vertices() const;
 
     /**
-     * The u1 DoFs of the locally owned interior vertices: V_h and the
+     * The DoFs (u1, u2) of the locally relevant vertices of V_h: those of
+     * the locally owned and ghost cells. A contact constraint of an active
+     * vertex must be known on every process that assembles a cell around
+     * it.
+     */
+    const std::vector<std::array<types::global_dof_index, 2>> &
+    locally_relevant_vertices() const;
+
+    /**
+     * The u1 DoFs of the locally relevant interior vertices: V_h and the
      * hanging vertices, whose dual cells make up ω_h. On the pieces of a
      * hanging vertex, λ_h is the constraint-weighted mean of the λ_a of its
      * parents (AffineConstraints::distribute() of the nodal vector).
@@ -134,13 +145,14 @@ namespace membranes
     IndexSet                                      locally_owned_dofs;
     MPI_Comm                                      mpi_communicator;
 
-    std::vector<Vertex>                interior_vertices;
-    IndexSet                           interior_vertex_dofs;
-    std::array<std::vector<double>, 2> lambda_i;
-    std::array<std::vector<double>, 2> stiffness_terms;
-    std::array<std::vector<double>, 2> load_terms;
-    double                             max_force;
-    double                             l2_force;
+    std::vector<Vertex>                                 interior_vertices;
+    std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
+    IndexSet                                            interior_vertex_dofs;
+    std::array<std::vector<double>, 2>                  lambda_i;
+    std::array<std::vector<double>, 2>                  stiffness_terms;
+    std::array<std::vector<double>, 2>                  load_terms;
+    double                                              max_force;
+    double                                              l2_force;
   };
 } // namespace membranes
 

@@ -1,6 +1,7 @@
 #ifndef membranes_discretization_h
 #define membranes_discretization_h
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/mapping.h>
@@ -38,6 +39,27 @@ namespace membranes
      * stiffness, degree 3 for smooth loads). */
     const Quadrature<dim> cell_quadrature;
   };
+
+
+
+  /**
+   * The triangulation of a run on the processes of @p mpi_communicator:
+   *
+   * - quadrilaterals: a parallel::distributed::Triangulation (p4est), on
+   *   any number of processes; one process is the case N = 1 of the same
+   *   class, so serial and parallel runs share every line of the program;
+   * - triangles: a serial Triangulation, on one process only (deal.II 9.4's
+   *   p4est triangulation has no simplices); a triangle scene run on more
+   *   processes is an InputError naming `Geometry/Cell type`.
+   *
+   * Mesh smoothing is off for both, so that a refinement step refines what
+   * the marking marked (and the hanging-node rule of at most one hanging
+   * node per edge, which every deal.II triangulation keeps).
+   */
+  template <int dim>
+  std::unique_ptr<Triangulation<dim>>
+  make_triangulation(const Parameters::CellType cell_type,
+                     const MPI_Comm             mpi_communicator);
 
 
 

@@ -20,13 +20,18 @@ namespace membranes
    * Field output (SPEC §3.4), each file to a temporary name and renamed, so
    * that no half-written file is left:
    * - for ParaView (`Write vtu`), one VTU file per cycle with u1, u2,
-   *   w = u1 − u2, λ_h (the nodal values λ_a), the active set indicator
-   *   and, when computed, the error indicator η_K, and a .pvd file that
-   *   lists the cycles;
+   *   w = u1 − u2, λ_h (the nodal values λ_a), the active set indicator,
+   *   the subdomain (the process that owns the cell) and, when computed,
+   *   the error indicator η_K, and a .pvd file that lists the cycles. On
+   *   N > 1 processes each writes its own cells to solution-NN.PPPP.vtu
+   *   and the first one the record solution-NN.pvtu that joins them (the
+   *   .pvd lists the records);
    * - for comparisons to round-off (`Write nodal values`), one CSV file
    *   per cycle, nodal-values-NN.csv, with one row per vertex in the order
-   *   of its u1 DoF: `x,y,u1,u2,lambda_h,active_set`, numbers with 17
-   *   significant digits. (VTU holds single precision values.)
+   *   of its position (x, then y), so that runs on different numbers of
+   *   processes give the same rows: `x,y,u1,u2,lambda_h,active_set`,
+   *   numbers with 17 significant digits. (VTU holds single precision
+   *   values.) The first process gathers and writes it.
    */
   template <int dim>
   class FieldOutput
@@ -35,7 +40,8 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
 
     FieldOutput(const Parameters::Output  &parameters,
-                const Discretization<dim> &discretization);
+                const Discretization<dim> &discretization,
+                const MPI_Comm             mpi_communicator);
 
     /**
      * Write what the scene asks for of cycle @p cycle. @p contact_fields has
@@ -53,8 +59,9 @@ namespace membranes
 
     /**
      * Write the sub-mesh S_h of the dual mesh of cycle @p cycle as
-     * dual-mesh-NN.vtu, one triangle per patch with the data @p names (see
-     * FluxReconstruction::patches()), and a dual-mesh.pvd over cycles.
+     * dual-mesh-NN.vtu (.pvtu on N > 1 processes), one triangle per patch
+     * with the data @p names (see FluxReconstruction::patches()), and a
+     * dual-mesh.pvd over cycles.
      */
     void
     write_dual_mesh(const unsigned int                               cycle,
@@ -62,14 +69,22 @@ namespace membranes
                     const std::vector<std::string>                  &names);
 
   private:
-    /** Write @p name of cycle @p cycle with @p writer, and its .pvd file. */
+    /**
+     * Write this process's piece of @p name of cycle @p cycle with
+     * @p write_piece; on N > 1 processes, the first one writes the .pvtu
+     * record of all pieces with @p write_record (given their file names);
+     * then the .pvd file over the cycles in @p written.
+     */
     void
-    write_cycle(const unsigned int                           cycle,
-                const std::string                           &name,
-                const std::function<void(std::ostream &)>   &writer,
-                std::vector<std::pair<double, std::string>> &written);
+    write_cycle(
+      const unsigned int                                           cycle,
+      const std::string                                           &name,
+      const std::function<void(std::ostream &)>                   &write_piece,
+      const std::function<void(std::ostream &,
+                               const std::vector<std::string> &)> &write_record,
+      std::vector<std::pair<double, std::string>>                 &written);
 
-    /** solution-NN.vtu and solution.pvd. */
+    /** solution-NN.vtu (or .pvtu and pieces) and solution.pvd. */
     void
     write_vtu(const unsigned int     cycle,
               const DoFHandler<dim> &dof_handler,
@@ -86,6 +101,7 @@ namespace membranes
 
     const Parameters::Output                   &parameters;
     const Discretization<dim>                  &discretization;
+    const MPI_Comm                              mpi_communicator;
     std::vector<std::pair<double, std::string>> cycles_written;
     std::vector<std::pair<double, std::string>> dual_mesh_cycles_written;
   };

@@ -3,6 +3,7 @@
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/index_set.h>
+#include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -36,10 +37,14 @@ namespace membranes
    * error, add a row to the report, write fields, refine (globally, or by
    * the estimator's indicators).
    *
-   * Data layout is that of deal.II's step-40: locally owned and locally
-   * relevant index sets, Trilinos vectors and matrices, ghosted vectors for
-   * reading, and output on the first process only; the triangulation is
-   * serial for now.
+   * Data layout is that of deal.II's step-40: a distributed triangulation
+   * (make_triangulation(): p4est for quadrilaterals, serial for triangles),
+   * locally owned and locally relevant index sets, Trilinos vectors and
+   * matrices, ghosted vectors for reading; every cell loop runs over the
+   * locally owned cells (and the ghost cells where a quantity of an owned
+   * vertex or edge needs its neighbours), every global quantity is an MPI
+   * reduction, and the terminal and report.csv are written by the first
+   * process. One process is the case N = 1 of the same code.
    */
   template <int dim>
   class MembraneProblem
@@ -81,11 +86,11 @@ namespace membranes
     const ProblemData<dim>    data;
     const Discretization<dim> discretization;
 
-    Triangulation<dim>        triangulation;
-    DoFHandler<dim>           dof_handler;
-    IndexSet                  locally_owned_dofs;
-    IndexSet                  locally_relevant_dofs;
-    AffineConstraints<double> hanging_node_constraints;
+    const std::unique_ptr<Triangulation<dim>> triangulation;
+    DoFHandler<dim>                           dof_handler;
+    IndexSet                                  locally_owned_dofs;
+    IndexSet                                  locally_relevant_dofs;
+    AffineConstraints<double>                 hanging_node_constraints;
 
     /** (u1h, u2h): locally owned entries, and a ghosted copy for reading. */
     VectorType solution;
@@ -105,8 +110,13 @@ namespace membranes
     Report                  report;
     FieldOutput<dim>        field_output;
 
-    /** Carries (u_h, λ_h) from one mesh to the next. */
-    std::unique_ptr<SolutionTransfer<dim, VectorType>> solution_transfer;
+    /**
+     * Carries (u_h, λ_h) from one mesh to the next: the distributed
+     * SolutionTransfer on p4est meshes, the serial one on triangles.
+     */
+    std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>>
+                                                       distributed_transfer;
+    std::unique_ptr<SolutionTransfer<dim, VectorType>> serial_transfer;
     std::vector<VectorType>                            previous_mesh_vectors;
 
     /** The row of the current cycle. */

@@ -56,6 +56,14 @@ namespace membranes
     double prop12_defect = 0;
     /** max_a |λ_a d_a (u1h − u2h)(a)| / (F max|u_h|), (4.8). */
     double complementarity_defect = 0;
+
+    /** The number of MPI processes of the run. */
+    unsigned int processes = 1;
+    /**
+     * Peak resident memory (VmHWM) of the run so far, summed over the
+     * processes, in MB: divided by the DoFs, the memory per DoF.
+     */
+    double memory_mb = 0;
   };
 
 
