@@ -1,9 +1,14 @@
 #!/usr/bin/env python3
-"""Bad scenes and bad command lines: ``bad_scenes.py membranes WORKDIR``.
+"""Bad scenes and bad command lines::
+
+    bad_scenes.py membranes WORKDIR [MPI_LAUNCHER]
 
 Every case must end with a non-zero exit status, exactly one line on stderr
 that starts with ``membranes: error:`` and names the offending parameter, and
-no output directory. A few good command lines (--help, --print-parameters)
+no output directory. With MPI_LAUNCHER (e.g. 'mpiexec -n', completed by
+the number of processes), a triangle
+scene on two processes is a case too (only the program's own lines of
+stderr count there: the launcher adds its report of the exit status). A few good command lines (--help, --print-parameters)
 are checked as well. Prints one PASS/FAIL line per case, exits 1 on any
 failure.
 """
@@ -79,7 +84,7 @@ def run(command):
     return subprocess.run(command, capture_output=True, text=True, timeout=60)
 
 
-def check_case(membranes, workdir, name, scene, extra, words):
+def check_case(membranes, workdir, name, scene, extra, words, launcher=()):
     outdir = os.path.join(workdir, "output")
     shutil.rmtree(outdir, ignore_errors=True)
     if scene is None:
@@ -89,8 +94,9 @@ def check_case(membranes, workdir, name, scene, extra, words):
         with open(scene_file, "w") as out:
             out.write(scene + "subsection Output\n  set Directory = %s\nend\n"
                       % outdir)
-    result = run([membranes] + extra + [scene_file])
-    lines = result.stderr.strip().splitlines()
+    result = run(list(launcher) + [membranes] + extra + [scene_file])
+    lines = [line for line in result.stderr.strip().splitlines()
+             if not launcher or line.startswith("membranes")]
     problems = []
     if result.returncode == 0:
         problems.append("exit status 0")
@@ -131,6 +137,12 @@ def main():
     with open(os.path.join(workdir, "garbage.msh"), "w") as out:
         out.write("$MeshFormat\nthis is not a mesh\n")
     results = [check_case(membranes, workdir, *case) for case in CASES]
+    if len(sys.argv) > 3:
+        results.append(check_case(
+            membranes, workdir, "triangles on two processes",
+            "subsection Geometry\n  set Cell type = triangle\nend\n", [],
+            ["Geometry/Cell type", "one process"],
+            launcher=sys.argv[3].split() + ["2"]))
     results.append(check_good_command_lines(membranes))
     print("%d passed, %d failed" % (results.count(True), results.count(False)))
     sys.exit(0 if all(results) else 1)

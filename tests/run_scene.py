@@ -1,8 +1,12 @@
 #!/usr/bin/env python3
-"""Run one scene for a test: ``run_scene.py OUTDIR membranes [args...]``.
+"""Run one scene for a test::
+
+    run_scene.py OUTDIR [--launcher 'mpiexec -n 2' --] membranes [args...]
 
 OUTDIR is removed first (so that no file of an earlier run can make a later
-check pass) and passed to the program as ``Output/Directory``.
+check pass) and passed to the program as ``Output/Directory``. With
+``--launcher``, the words up to ``--`` start the program (an MPI launcher
+and its options).
 """
 import shutil
 import subprocess
@@ -11,10 +15,16 @@ import sys
 
 def main():
     if len(sys.argv) < 3:
-        sys.exit("usage: run_scene.py OUTDIR membranes [args...]")
+        sys.exit("usage: run_scene.py OUTDIR [--launcher WORDS... --] "
+                 "membranes [args...]")
     outdir, command = sys.argv[1], sys.argv[2:]
+    launcher = []
+    if command[0] == "--launcher":
+        end = command.index("--")
+        launcher, command = command[1:end], command[end + 1:]
     shutil.rmtree(outdir, ignore_errors=True)
-    command = command[:1] + ["--set", "Output/Directory=" + outdir] + command[1:]
+    command = (launcher + command[:1] + ["--set", "Output/Directory=" + outdir]
+               + command[1:])
     print(" ".join(command), flush=True)
     sys.exit(subprocess.call(command))
 
