@@ -6,9 +6,9 @@
 #
 # Defaults: build/membranes of this repository and
 # /tmp/membranes-mpi-scaling. Runs case M (parameters/case-m-quadrilateral.prm,
-# Q1, p4est mesh) with Initial refinement = 10 and two cycles of global
-# refinement: 2 101 250 DoFs on cycle 0 and 8 396 802 on cycle 1, first on
-# one process, then on two (mpiexec -n 2), CG-AMG, no field output. The same
+# Q1, p4est mesh) under global refinement with nested iteration, 10 cycles:
+# 2·(2^(k+2)+1)² DoFs on cycle k, 8 396 802 on the last, first on one
+# process, then on two (mpiexec -n 2), CG-AMG, no field output. The same
 # binary and the same scene, one after the other in one run of this script.
 #
 # The table of benchmarks/mpi_scaling_table.py is printed at the end and kept
@@ -17,13 +17,13 @@
 # memory per DoF (report.csv's memory_mb, summed over the processes), and
 # the check that both runs computed the same thing (DoFs, active vertices,
 # energy error). The exit status is that script's.
-# REFINEMENT=k in the environment sets Initial refinement for a quick try.
+# CYCLES=n in the environment shortens the run for a quick try.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 membranes=${1:-$root/build/membranes}
 out=${2:-/tmp/membranes-mpi-scaling}
-refinement=${REFINEMENT:-10}
+cycles=${CYCLES:-10}
 scene=$root/parameters/case-m-quadrilateral.prm
 
 if [[ ! -x $membranes ]]; then
@@ -36,8 +36,7 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 for processes in 1 2; do
   command=(mpiexec -n "$processes" "$membranes"
-           --set "Geometry/Initial refinement=$refinement"
-           --set "Refinement/Cycles=2"
+           --set "Refinement/Cycles=$cycles"
            --set "Solver/Linear solver=cg-amg"
            --set "Output/Write vtu=false"
            --set "Output/Directory=$out/np$processes"
