@@ -45,7 +45,8 @@ namespace membranes
               r.measure_defect,
               r.conservation_defect,
               r.balance_defect,
-              r.time_flux};
+              r.time_flux,
+              r.levels};
     }
 
     /** Columns that hold whole numbers. */
@@ -55,7 +56,7 @@ namespace membranes
       return column == "cycle" || column == "cells" || column == "dofs" ||
              column == "active_set_iterations" || column == "active_vertices" ||
              column == "linear_iterations" ||
-             column == "hanging_active_vertices";
+             column == "hanging_active_vertices" || column == "levels";
     }
   } // namespace
 
@@ -96,7 +97,8 @@ namespace membranes
                                                 "measure_defect",
                                                 "conservation_defect",
                                                 "balance_defect",
-                                                "time_flux_s"};
+                                                "time_flux_s",
+                                                "levels"};
     return names;
   }
 
