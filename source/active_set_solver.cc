@@ -377,7 +377,7 @@ namespace membranes
 
         const std::string reached =
           "relative KKT residual " + format(statistics.kkt_residual) +
-          " > Solver/Tolerance = " + format(parameters.tolerance);
+          " (Solver/Tolerance = " + format(parameters.tolerance) + ")";
         if (n_changes == 0)
           {
             if (statistics.kkt_residual <= parameters.tolerance)
