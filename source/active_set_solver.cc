@@ -1,15 +1,28 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/timer.h>
+#include <iomanip>
 #include <limits>
 #include <membranes/active_set_solver.h>
 #include <membranes/coupled_system.h>
 #include <membranes/decoupled_system.h>
+#include <sstream>
 
 namespace membranes
 {
   namespace
   {
+    /** @p value with 3 significant digits, e.g. "1.23e-08". */
+    std::string
+    format(const double value)
+    {
+      std::ostringstream text;
+      text << std::setprecision(3) << value;
+      return text.str();
+    }
+
+
+
     /** The linear problem of one iteration, as `Solver/Method` asks. */
     template <int dim>
     std::unique_ptr<ActiveSetSystem<dim>>
@@ -28,7 +41,128 @@ namespace membranes
                                                   data,
                                                   mpi_communicator);
     }
+
+    /** @p set with the status of the vertices @p dofs changed. */
+    IndexSet
+    toggled(const IndexSet                             &set,
+            const std::vector<types::global_dof_index> &dofs)
+    {
+      IndexSet changed(set.size());
+      for (const auto dof : dofs)
+        changed.add_index(dof);
+      changed.compress();
+      IndexSet result = set;
+      result.add_indices(changed);
+      result.subtract_set(set & changed);
+      return result;
+    }
   } // namespace
+
+
+
+  ActiveSetHistory::ActiveSetHistory(const MPI_Comm mpi_communicator)
+    : mpi_communicator(mpi_communicator)
+    , n_cycles(0)
+    , least_index_rule(false)
+  {}
+
+
+
+  void
+  ActiveSetHistory::restart(const IndexSet &initial_active_set)
+  {
+    visited          = {initial_active_set};
+    n_cycles         = 0;
+    least_index_rule = false;
+  }
+
+
+
+  std::optional<unsigned int>
+  ActiveSetHistory::find(const IndexSet &set) const
+  {
+    for (unsigned int i = 0; i < visited.size(); ++i)
+      if (Utilities::MPI::min(visited[i] == set ? 1 : 0, mpi_communicator) == 1)
+        return i;
+    return std::nullopt;
+  }
+
+
+
+  ActiveSetHistory::Step
+  ActiveSetHistory::next(const IndexSet                  &active_set,
+                         const std::vector<StatusChange> &changes)
+  {
+    std::vector<types::global_dof_index> local_dofs;
+    for (const auto &change : changes)
+      local_dofs.push_back(change.dof);
+    std::sort(local_dofs.begin(), local_dofs.end());
+
+    Step step;
+    step.wanted =
+      Utilities::MPI::sum<types::global_dof_index>(changes.size(),
+                                                   mpi_communicator);
+    step.changed          = step.wanted;
+    step.active_set       = toggled(active_set, local_dofs);
+    step.least_index_rule = least_index_rule;
+    if (step.wanted > 0 && !least_index_rule)
+      step.cycle_to = find(step.active_set);
+
+    if (step.wanted > 0 && (step.cycle_to || least_index_rule))
+      {
+        // All wanted changes of all processes, by decreasing violation
+        // (ties by DoF index, so that every process sorts alike).
+        std::vector<std::pair<double, types::global_dof_index>> ranked;
+        for (const auto &process_changes :
+             Utilities::MPI::all_gather(mpi_communicator, changes))
+          for (const auto &change : process_changes)
+            ranked.emplace_back(-change.violation, change.dof);
+        std::sort(ranked.begin(), ranked.end());
+
+        // Change only the first @p n of them (this process: its own).
+        const auto change_first = [&](const types::global_dof_index n) {
+          std::vector<types::global_dof_index> dofs;
+          for (types::global_dof_index i = 0; i < n; ++i)
+            if (std::binary_search(local_dofs.begin(),
+                                   local_dofs.end(),
+                                   ranked[i].second))
+              dofs.push_back(ranked[i].second);
+          step.changed    = n;
+          step.active_set = toggled(active_set, dofs);
+        };
+
+        for (bool repeats = !least_index_rule; repeats;)
+          {
+            ++n_cycles;
+            const types::global_dof_index share =
+              (step.wanted + (types::global_dof_index(1) << n_cycles) - 1) >>
+              n_cycles;
+            least_index_rule = (share <= 1);
+            if (least_index_rule)
+              break;
+            change_first(share);
+            repeats = find(step.active_set).has_value();
+          }
+        if (least_index_rule)
+          {
+            std::sort(ranked.begin(), ranked.end(), [](auto &x, auto &y) {
+              return x.second < y.second;
+            });
+            change_first(1);
+            step.least_index_rule = true;
+          }
+      }
+    visited.push_back(step.active_set);
+    return step;
+  }
+
+
+
+  unsigned int
+  ActiveSetHistory::cycles() const
+  {
+    return n_cycles;
+  }
 
 
 
@@ -47,6 +181,7 @@ namespace membranes
                                     discretization,
                                     data,
                                     mpi_communicator))
+    , history(mpi_communicator)
   {}
 
 
@@ -70,26 +205,55 @@ namespace membranes
 
 
   template <int dim>
-  template <typename LambdaOfVertex>
-  IndexSet
-  ActiveSetSolver<dim>::active_set_for(const DiscreteAction<dim> &action,
-                                       const VectorType     &ghosted_solution,
-                                       const LambdaOfVertex &lambda) const
+  typename ActiveSetSolver<dim>::Scales
+  ActiveSetSolver<dim>::scales(const DiscreteAction<dim> &action,
+                               const VectorType &ghosted_solution) const
   {
-    IndexSet    active_set(dof_handler->n_dofs());
-    const auto &vertices = action.vertices();
+    const double tiny = std::numeric_limits<double>::min();
+    return {std::max(action.force_scale(), tiny),
+            std::max(action.force_scale_l2(), tiny),
+            std::max(ghosted_solution.linfty_norm(), tiny)};
+  }
+
+
+
+  template <int dim>
+  double
+  ActiveSetSolver<dim>::contact_lambda(const DiscreteAction<dim> &action,
+                                       const unsigned int         k) const
+  {
+    return (data.mu[1] * action.lambda_from_membrane(0, k) +
+            data.mu[0] * action.lambda_from_membrane(1, k)) /
+           (data.mu[0] + data.mu[1]);
+  }
+
+
+
+  template <int dim>
+  std::vector<StatusChange>
+  ActiveSetSolver<dim>::wanted_changes(const DiscreteAction<dim> &action,
+                                       const VectorType &ghosted_solution,
+                                       const IndexSet   &active_set) const
+  {
+    const double epsilon = parameters.tolerance;
+    const double u_scale = scales(action, ghosted_solution).displacement;
+
+    std::vector<StatusChange> changes;
+    const auto               &vertices = action.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a = vertices[k];
-        const double w =
-          ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]];
         const double c =
           data.mu_bar * a.stiffness_diagonal / a.dual_cell_measure;
-        if (lambda(k) - c * w > 0)
-          active_set.add_index(a.dof[0]);
+        const double violation =
+          active_set.is_element(a.dof[0]) ?
+            -contact_lambda(action, k) / (c * u_scale) :
+            -(ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]]) /
+              u_scale;
+        if (violation > epsilon)
+          changes.push_back({a.dof[0], violation / epsilon});
       }
-    active_set.compress();
-    return active_set;
+    return changes;
   }
 
 
@@ -126,9 +290,26 @@ namespace membranes
     const VectorType          &ghosted_solution,
     const VectorType          &ghosted_lambda_h) const
   {
-    return active_set_for(action, ghosted_solution, [&](const unsigned int k) {
-      return ghosted_lambda_h[action.vertices()[k].dof[0]];
-    });
+    const double epsilon = parameters.tolerance;
+    const double u_scale = std::max(ghosted_solution.linfty_norm(),
+                                    std::numeric_limits<double>::min());
+
+    IndexSet    active_set(dof_handler->n_dofs());
+    const auto &vertices = action.vertices();
+    for (const auto &a : vertices)
+      {
+        const double c =
+          data.mu_bar * a.stiffness_diagonal / a.dual_cell_measure;
+        const double lambda = ghosted_lambda_h[a.dof[0]] / (c * u_scale);
+        const double w =
+          (ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]]) / u_scale;
+        const bool degenerate =
+          std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
+        if (!degenerate && lambda - w > 0)
+          active_set.add_index(a.dof[0]);
+      }
+    active_set.compress();
+    return active_set;
   }
 
 
@@ -158,20 +339,14 @@ namespace membranes
         dual               = std::max(dual, -force);
         complementarity    = std::max(complementarity, std::abs(force * w));
       }
-    const double u_scale = std::max(ghosted_solution.linfty_norm(),
-                                    std::numeric_limits<double>::min());
-    const double f_scale =
-      std::max(action.force_scale(), std::numeric_limits<double>::min());
-    const double f_scale_l2 =
-      std::max(action.force_scale_l2(), std::numeric_limits<double>::min());
-
+    const Scales scale = scales(action, ghosted_solution);
     return std::max(
       {std::sqrt(Utilities::MPI::sum(equilibrium, mpi_communicator)) /
-         f_scale_l2,
-       Utilities::MPI::max(primal, mpi_communicator) / u_scale,
-       Utilities::MPI::max(dual, mpi_communicator) / f_scale,
+         scale.force_l2,
+       Utilities::MPI::max(primal, mpi_communicator) / scale.displacement,
+       Utilities::MPI::max(dual, mpi_communicator) / scale.force,
        Utilities::MPI::max(complementarity, mpi_communicator) /
-         (f_scale * u_scale)});
+         (scale.force * scale.displacement)});
   }
 
 
@@ -197,6 +372,10 @@ namespace membranes
     };
     system->prepare(solution, linear_tolerance(), statistics);
 
+    history.restart(active_set);
+    // The residual of the last iteration in which the active set did not
+    // change: it has to decrease while the linear solves refine it.
+    double settled_residual = std::numeric_limits<double>::infinity();
     for (unsigned int iteration = 1;; ++iteration)
       {
         system->solve(action,
@@ -208,32 +387,61 @@ namespace membranes
         timer.restart();
         ghosted_solution = solution;
         action.compute(ghosted_solution);
-        const IndexSet next_active_set =
-          active_set_for(action, ghosted_solution, [&](const unsigned int k) {
-            return action.lambda(k);
-          });
+        const std::vector<StatusChange> changes =
+          wanted_changes(action, ghosted_solution, active_set);
+        const auto n_changes =
+          Utilities::MPI::sum<types::global_dof_index>(changes.size(),
+                                                       mpi_communicator);
         statistics.kkt_residual =
           kkt_residual(action, ghosted_solution, active_set);
         statistics.iterations = iteration;
-        const bool repeated =
-          Utilities::MPI::min(next_active_set == active_set ? 1 : 0,
-                              mpi_communicator) == 1;
         statistics.solve_time += timer.wall_time();
 
         pcout << "      active set iteration " << iteration << ": "
               << Utilities::MPI::sum(active_set.n_elements(), mpi_communicator)
-              << " active vertices, relative KKT residual "
-              << statistics.kkt_residual << ", " << system->description()
-              << std::endl;
+              << " active vertices, " << n_changes
+              << " to change, relative KKT residual " << statistics.kkt_residual
+              << ", " << system->description() << std::endl;
 
-        active_set = next_active_set;
-        if (repeated && statistics.kkt_residual <= parameters.tolerance)
-          return statistics;
+        const std::string reached =
+          "relative KKT residual " + format(statistics.kkt_residual) +
+          " (Solver/Tolerance = " + format(parameters.tolerance) + ")";
+        if (n_changes == 0)
+          {
+            if (statistics.kkt_residual <= parameters.tolerance)
+              return statistics;
+            if (statistics.kkt_residual >= settled_residual)
+              throw ActiveSetNotConverged(
+                "the active set method stalls after " +
+                std::to_string(iteration) +
+                " iterations: the active set has settled, but the " + reached +
+                " does not decrease any more (the accuracy of " +
+                "the linear solver, " + system->description() + ", limits it)");
+            settled_residual = statistics.kkt_residual;
+          }
+        else
+          settled_residual = std::numeric_limits<double>::infinity();
+
         if (iteration == parameters.max_active_set_iterations)
-          throw std::runtime_error(
+          throw ActiveSetNotConverged(
             "Solver/Max active set iterations = " + std::to_string(iteration) +
-            " reached without convergence (relative KKT residual " +
-            std::to_string(statistics.kkt_residual) + ")");
+            " reached without convergence: " + reached + ", " +
+            std::to_string(n_changes) + " vertices still to change");
+
+        if (n_changes > 0)
+          {
+            const auto step = history.next(active_set, changes);
+            if (step.cycle_to)
+              pcout << "      cycle: iteration " << iteration + 1
+                    << " would repeat the active set of iteration "
+                    << *step.cycle_to + 1 << "; " << step.changed << " of "
+                    << step.wanted << " vertices change"
+                    << (step.least_index_rule ?
+                          " (Murty's least-index rule from now on)" :
+                          " (the largest violations)")
+                    << std::endl;
+            active_set = step.active_set;
+          }
       }
   }
 

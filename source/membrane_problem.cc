@@ -53,17 +53,17 @@ namespace membranes
    */
   template <int dim>
   void
-  MembraneProblem<dim>::create_output_directory() const
+  MembraneProblem<dim>::create_output_directory(
+    const std::string &directory) const
   {
     if (pcout.is_active())
       {
         std::error_code error;
-        std::filesystem::create_directories(parameters.output.directory, error);
-        if (error ||
-            !std::filesystem::is_directory(parameters.output.directory))
+        std::filesystem::create_directories(directory, error);
+        if (error || !std::filesystem::is_directory(directory))
           throw Parameters::invalid_entry(
             "Output/Directory",
-            parameters.output.directory,
+            directory,
             "cannot create this directory (" +
               (error ? error.message() : "a file of that name exists") + ")");
       }
@@ -153,12 +153,27 @@ namespace membranes
 
 
 
+  /**
+   * The active set method on the current mesh. If it stops without
+   * convergence, the last iterate is written by write_unconverged_iterate()
+   * and the run ends with the solver's message: no row is added to the
+   * report.
+   */
   template <int dim>
   void
   MembraneProblem<dim>::solve()
   {
-    const auto statistics =
-      active_set_solver.solve(action, solution, active_set);
+    ActiveSetStatistics statistics;
+    try
+      {
+        statistics = active_set_solver.solve(action, solution, active_set);
+      }
+    catch (const ActiveSetNotConverged &error)
+      {
+        throw std::runtime_error("cycle " + std::to_string(record.cycle) +
+                                 ": " + error.what() + "; " +
+                                 write_unconverged_iterate());
+      }
     ghosted_solution = solution;
 
     record.active_set_iterations = statistics.iterations;
@@ -168,6 +183,19 @@ namespace membranes
     record.time_solve            = statistics.solve_time;
     record.active_vertices =
       Utilities::MPI::sum(active_set.n_elements(), mpi_communicator);
+  }
+
+
+
+  /** λ_h: λ_a of V_h, and on hanging vertices by their constraints. */
+  template <int dim>
+  void
+  MembraneProblem<dim>::compute_lambda_h()
+  {
+    VectorType owned_lambda(locally_owned_dofs, mpi_communicator);
+    action.fill_nodal_vector(owned_lambda);
+    hanging_node_constraints.distribute(owned_lambda);
+    lambda_h = owned_lambda;
   }
 
 
@@ -184,10 +212,7 @@ namespace membranes
   void
   MembraneProblem<dim>::postprocess()
   {
-    VectorType owned_lambda(locally_owned_dofs, mpi_communicator);
-    action.fill_nodal_vector(owned_lambda);
-    hanging_node_constraints.distribute(owned_lambda);
-    lambda_h = owned_lambda;
+    compute_lambda_h();
     flux_reconstruction.set_lambda_h(dof_handler,
                                      lambda_h,
                                      action.dual_mesh_vertices());
@@ -319,6 +344,59 @@ namespace membranes
 
 
   /**
+   * λ_a in the u1 slot and the active set indicator (1 or 0) in the u2 slot
+   * of every vertex of V_h (ghosted), as FieldOutput writes them.
+   */
+  template <int dim>
+  typename MembraneProblem<dim>::VectorType
+  MembraneProblem<dim>::contact_fields() const
+  {
+    VectorType fields(locally_owned_dofs, mpi_communicator);
+    fields = 0;
+    for (const auto &a : action.vertices())
+      {
+        fields[a.dof[0]] = lambda_h[a.dof[0]];
+        fields[a.dof[1]] = active_set.is_element(a.dof[0]) ? 1 : 0;
+      }
+    fields.compress(VectorOperation::insert);
+    VectorType ghosted_fields(locally_owned_dofs,
+                              locally_relevant_dofs,
+                              mpi_communicator);
+    ghosted_fields = fields;
+    return ghosted_fields;
+  }
+
+
+
+  /**
+   * The last iterate of an active set method that did not converge, to see
+   * why, never as a result: VTU and nodal values of u1, u2, λ_h and the
+   * active set in `<Directory>/unconverged/`, whatever the scene asks for.
+   * Returns where they are.
+   */
+  template <int dim>
+  std::string
+  MembraneProblem<dim>::write_unconverged_iterate()
+  {
+    ghosted_solution = solution;
+    compute_lambda_h();
+
+    Parameters::Output output = parameters.output;
+    output.directory += "/unconverged";
+    output.write_vtu          = true;
+    output.write_nodal_values = true;
+    create_output_directory(output.directory);
+    FieldOutput<dim>(output, discretization, mpi_communicator)
+      .write(
+        record.cycle, dof_handler, ghosted_solution, contact_fields(), nullptr);
+    const std::string cycle = Utilities::int_to_string(record.cycle, 2);
+    return "the last iterate is in " + output.directory + " (solution-" +
+           cycle + ".vtu, nodal-values-" + cycle + ".csv), not in the report";
+  }
+
+
+
+  /**
    * u1, u2, u1 − u2, λ_h and the active set as VTU, and the nodal values as
    * CSV, if the scene asks for them.
    */
@@ -328,22 +406,10 @@ namespace membranes
   {
     if (!parameters.output.write_vtu && !parameters.output.write_nodal_values)
       return;
-    VectorType contact_fields(locally_owned_dofs, mpi_communicator);
-    contact_fields = 0;
-    for (const auto &a : action.vertices())
-      {
-        contact_fields[a.dof[0]] = lambda_h[a.dof[0]];
-        contact_fields[a.dof[1]] = active_set.is_element(a.dof[0]) ? 1 : 0;
-      }
-    contact_fields.compress(VectorOperation::insert);
-    VectorType ghosted_fields(locally_owned_dofs,
-                              locally_relevant_dofs,
-                              mpi_communicator);
-    ghosted_fields = contact_fields;
     field_output.write(cycle,
                        dof_handler,
                        ghosted_solution,
-                       ghosted_fields,
+                       contact_fields(),
                        indicators.size() ? &indicators : nullptr);
     if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
@@ -453,6 +519,7 @@ namespace membranes
         transfer_solution();
         record.time_setup = timer.wall_time();
         record.cells      = triangulation->n_global_active_cells();
+        record.levels     = triangulation->n_global_levels();
         record.dofs       = dof_handler.n_dofs();
         pcout << "Cycle " << cycle << ": " << record.cells << " cells, "
               << record.dofs << " DoFs";
@@ -486,7 +553,7 @@ namespace membranes
               << " active vertices, " << record.wall_time << " s" << std::endl;
 
         if (cycle == 0)
-          create_output_directory();
+          create_output_directory(parameters.output.directory);
         report.add(record);
         output_results(cycle);
         if (cycle + 1 < parameters.refinement.cycles)

@@ -46,6 +46,7 @@ namespace membranes
               r.conservation_defect,
               r.balance_defect,
               r.time_flux,
+              r.levels,
               r.processes,
               r.memory_mb};
     }
@@ -57,7 +58,8 @@ namespace membranes
       return column == "cycle" || column == "cells" || column == "dofs" ||
              column == "active_set_iterations" || column == "active_vertices" ||
              column == "linear_iterations" ||
-             column == "hanging_active_vertices" || column == "processes";
+             column == "hanging_active_vertices" || column == "levels" ||
+             column == "processes";
     }
   } // namespace
 
@@ -99,6 +101,7 @@ namespace membranes
                                                 "conservation_defect",
                                                 "balance_defect",
                                                 "time_flux_s",
+                                                "levels",
                                                 "processes",
                                                 "memory_mb"};
     return names;

@@ -30,6 +30,8 @@ Checks (COL is a column name from the header, VALUE a number):
     As ``--max``, ignoring the first row.
 ``--max-last COL<=VALUE``
     As ``--max``, on the last row only (the finest mesh).
+``--min-last COL>=VALUE``
+    As ``--min``, on the last row only.
 ``--empty COL``
     Every value of COL is empty.
 ``--filled COL``
@@ -40,8 +42,8 @@ Checks (COL is a column name from the header, VALUE a number):
     The non-empty values of COL strictly decrease from row to row.
 
 Checks that look at non-empty values (``--max``, ``--min``,
-``--max-after-first``, ``--max-last``, ``--decreasing``) fail when there is nothing to look
-at, so that a quantity that was silently not computed does not pass.  NaN
+``--max-after-first``, ``--max-last``, ``--min-last``, ``--decreasing``)
+fail when there is nothing to look at, so that a quantity that was silently not computed does not pass.  NaN
 never satisfies a bound.
 
 Exit status: 0 if every check passes; 1 if a check fails, a column is
@@ -258,14 +260,26 @@ def check_max_after_first(report, arg):
                        lambda value, limit: value <= limit, "<=")
 
 
-def check_max_last(report, arg):
-    """The last row's value <= bound."""
+def last_row_check(report, arg, relation):
+    """Compare the last row's value of a column with a bound."""
     column, bound = arg
     values = report.values(column)
     if not values:
         return False, "no rows"
+    satisfied = ((lambda value, limit: value <= limit) if relation == "<="
+                 else (lambda value, limit: value >= limit))
     return bound_check([None] * (len(values) - 1) + values[-1:], bound,
-                       lambda value, limit: value <= limit, "<=")
+                       satisfied, relation)
+
+
+def check_max_last(report, arg):
+    """The last row's value <= bound."""
+    return last_row_check(report, arg, "<=")
+
+
+def check_min_last(report, arg):
+    """The last row's value >= bound."""
+    return last_row_check(report, arg, ">=")
 
 
 def check_empty(report, column):
@@ -321,6 +335,8 @@ CHECKS = {
                           lambda a: f"{a[0]}<={fmt(a[1])}"),
     "--max-last": (check_max_last, lambda s: split_bound(s, "<="),
                    lambda a: f"{a[0]}<={fmt(a[1])}"),
+    "--min-last": (check_min_last, lambda s: split_bound(s, ">="),
+                   lambda a: f"{a[0]}>={fmt(a[1])}"),
     "--empty": (check_empty, str, str),
     "--filled": (check_filled, str, str),
     "--rows": (check_rows, non_negative_int, str),
@@ -330,7 +346,7 @@ CHECKS = {
 METAVARS = {"--rate": "COL>=VALUE", "--dof-rate": "COL>=VALUE",
             "--band": "COL<=VALUE", "--max": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
-            "--max-last": "COL<=VALUE",
+            "--max-last": "COL<=VALUE", "--min-last": "COL>=VALUE",
             "--empty": "COL", "--filled": "COL", "--rows": "N",
             "--decreasing": "COL"}
 
@@ -362,7 +378,7 @@ def columns_of(option, argument):
     if option in ("--rate", "--dof-rate"):
         return [argument[0], DOFS]
     if option in ("--max", "--min", "--max-after-first", "--max-last",
-                  "--band"):
+                  "--min-last", "--band"):
         return [argument[0]]
     if option == "--rows":
         return []

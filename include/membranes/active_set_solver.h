@@ -11,10 +11,129 @@
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <memory>
+#include <optional>
+#include <stdexcept>
+#include <vector>
 
 namespace membranes
 {
   using namespace dealii;
+
+  /**
+   * The active set method stopped without a converged iterate: at
+   * `Solver/Max active set iterations`, or when the active set no longer
+   * changes but the relative KKT residual stays above `Solver/Tolerance`.
+   * The message says which and the residual reached; the solution and the
+   * active set passed to ActiveSetSolver::solve() hold the last iterate.
+   */
+  class ActiveSetNotConverged : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+
+
+  /**
+   * A vertex whose status the active set method wants to change: its u1 DoF
+   * and by how much its test is violated, in units of the band of
+   * indifference (see ActiveSetSolver), so at least 1.
+   */
+  struct StatusChange
+  {
+    types::global_dof_index dof;
+    double                  violation;
+
+    /** For Utilities::MPI::all_gather(). */
+    template <class Archive>
+    void
+    serialize(Archive &archive, const unsigned int)
+    {
+      archive &dof &violation;
+    }
+  };
+
+
+
+  /**
+   * The active sets the active set method has visited on one mesh, and the
+   * remedy against cycling.
+   *
+   * The plain update changes the status of every vertex whose test is
+   * violated. For an M-matrix (non-obtuse meshes) this converges
+   * monotonically, but in general the primal-dual active set method, a
+   * semismooth Newton method for the complementarity problem, may cycle:
+   * return to an active set it has already visited, and go round for ever.
+   * Each update is therefore checked against all active sets visited on
+   * the current mesh (the initial one included). When it would return to
+   * one of them, the update is restricted to the vertices with the largest
+   * violations: on the r-th cycle detected on this mesh to ⌈n / 2^r⌉ of the
+   * n vertices that want to change; if that set was visited too, r is
+   * raised again. Once the share is down to one vertex, the method
+   * continues on this mesh with Murty's least-index rule: change only the
+   * wanted vertex of least DoF index. That rule terminates for every linear
+   * complementarity problem with a P-matrix (K. G. Murty, Note on a
+   * Bard-type scheme for solving the complementarity problem, Opsearch 11,
+   * 1974), and ours has one: eliminating the displacements leaves the Schur
+   * complement of the symmetric positive definite system on the contact
+   * vertices, which is symmetric positive definite. The halving can only happen
+   * log2(n) times, so the method terminates on every mesh; a cycle costs
+   * iterations, not convergence.
+   *
+   * Under MPI each process keeps the locally owned part of the sets; the
+   * comparisons and the choice of vertices are global.
+   */
+  class ActiveSetHistory
+  {
+  public:
+    explicit ActiveSetHistory(const MPI_Comm mpi_communicator);
+
+    /** Forget all, and start a new mesh at @p initial_active_set. */
+    void
+    restart(const IndexSet &initial_active_set);
+
+    /** What one update did. */
+    struct Step
+    {
+      /** The next active set (locally owned part). */
+      IndexSet active_set;
+      /** How many vertices wanted to change, and how many did. */
+      types::global_dof_index wanted, changed;
+      /**
+       * The number of the visited set (0 for the initial one, k for the
+       * set of iteration k + 1) that the plain update would have
+       * returned to, if a cycle was detected.
+       */
+      std::optional<unsigned int> cycle_to;
+      /** Whether the update followed Murty's least-index rule. */
+      bool least_index_rule;
+    };
+
+    /**
+     * The active set after @p active_set (the last one visited), changed
+     * at the locally owned vertices @p changes or, if that would close a
+     * cycle, at the part of them that the remedy allows. The result is
+     * recorded as visited.
+     */
+    Step
+    next(const IndexSet &active_set, const std::vector<StatusChange> &changes);
+
+    /** Cycles detected since restart(). */
+    unsigned int
+    cycles() const;
+
+  private:
+    /** The number of the visited set equal to @p set (on all processes). */
+    std::optional<unsigned int>
+    find(const IndexSet &set) const;
+
+    const MPI_Comm        mpi_communicator;
+    std::vector<IndexSet> visited;
+    unsigned int          n_cycles;
+    bool                  least_index_rule;
+  };
+
+
 
   /**
    * The primal-dual active set method (a semismooth Newton method) for the
@@ -27,17 +146,49 @@ namespace membranes
    *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a,
    *
    * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
-   * obstacle problem for w = u1 − u2, SPEC §1), so the test does not depend
-   * on how the data are scaled. Each iteration solves the linear problem
-   * W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the coupled pair
-   * (CoupledSystem, `Solver/Method = coupled`) or on the sum and the
-   * difference of the membranes (DecoupledSystem, `decoupled`). Both give
-   * the same iterate; λ_a, the next active set and the KKT residual are
-   * computed from it in the same way.
+   * obstacle problem for w = u1 − u2, SPEC §1). Each iteration solves the
+   * linear problem W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the
+   * coupled pair (CoupledSystem, `Solver/Method = coupled`) or on the sum
+   * and the difference of the membranes (DecoupledSystem, `decoupled`).
+   * Both give the same iterate; λ_a, the next active set and the KKT
+   * residual are computed from it in the same way.
    *
-   * The iteration stops when the active set repeats and the relative KKT
-   * residual (see kkt_residual()) is at most `Tolerance`. If that does not
-   * happen within `Max active set iterations`, solve() throws.
+   * <b>Decisions relative to the data.</b> In the units of the data, the
+   * test reads λ̂_a − Ŵ_a > 0 with
+   *
+   *   λ̂_a = λ_a / (c_a U_∞),   Ŵ_a = W_a / U_∞,   U_∞ = max|U|,
+   *
+   * both unchanged when the loads and g are multiplied by a factor, or μ1
+   * and μ2 (with the loads) by a factor. (c_a U_∞ d_a = μ̄ ∫|∇φ_a|² U_∞ is
+   * the size of the forces of the obstacle problem for w at a.) After a
+   * solve, W_a = 0 on A and λ_a = 0 off A, up to round-off, so the test
+   * keeps an active vertex iff λ_a > 0 and activates an inactive one iff
+   * W_a < 0; c_a only matters for the initial active set of a mesh. Where
+   * both are zero in exact arithmetic (a degenerate vertex: the membranes
+   * touch without pressing on each other), the sign of the test is the
+   * sign of round-off, a vertex may flip at every iteration, and the plain
+   * method cycles. Each sign is therefore read with a band of indifference
+   * ε = `Tolerance`:
+   * - an active vertex is released iff λ̂_a < −ε,
+   * - an inactive vertex is activated iff Ŵ_a < −ε,
+   * - every other vertex keeps its status (hysteresis).
+   * The band is about that of the KKT residual: a vertex kept in it adds at
+   * most about ε to its dual (−λ_a d_a / F_∞, F_∞ ≥ μ̄ ∫|∇φ_a|² U_∞) or
+   * primal (−W_a / U_∞) feasibility part, so either status is an acceptable
+   * answer for it. The test uses the λ_a of the obstacle problem for w,
+   * (μ2 λ_1a + μ1 λ_2a) / (μ1 + μ2) with λ_ia from membrane i by (4.5) (the
+   * two agree by Prop. 12): its round-off is that of forces of tension μ̄,
+   * where the plain mean of the two would carry the round-off of the
+   * stiffer membrane, max(μ1, μ2)/μ̄ times larger than the band for a
+   * tension ratio of 1e8.
+   *
+   * <b>Convergence.</b> The iteration stops when no vertex wants to change
+   * and the relative KKT residual (kkt_residual()) is at most `Tolerance`.
+   * If the active set has settled but the residual does not decrease any
+   * more (the accuracy of the linear solver limits it), or at
+   * `Max active set iterations`, solve() throws ActiveSetNotConverged with
+   * the residual reached. Cycling is detected and remedied by
+   * ActiveSetHistory.
    */
   template <int dim>
   class ActiveSetSolver
@@ -63,7 +214,8 @@ namespace membranes
      * Run the active set method from the initial guess @p solution (locally
      * owned entries) and the initial active set @p active_set (u1 DoFs of
      * active vertices). On return both hold the converged iterate, and
-     * @p action holds λ_a for it.
+     * @p action holds λ_a for it; if ActiveSetNotConverged is thrown, the
+     * last iterate.
      */
     Statistics
     solve(DiscreteAction<dim> &action,
@@ -72,9 +224,9 @@ namespace membranes
 
     /**
      * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
-     * mesh's solution and λ_h interpolated onto it (nested iteration):
-     * vertices between two active ones stay active, the others are decided
-     * by the same test as in the iteration.
+     * mesh's solution and λ_h interpolated onto it (nested iteration). A
+     * vertex where both |λ̂_a| ≤ ε and |Ŵ_a| ≤ ε is degenerate up to
+     * round-off; it starts inactive, as every vertex of the first mesh does.
      */
     IndexSet
     initial_active_set(const DiscreteAction<dim> &action,
@@ -96,6 +248,18 @@ namespace membranes
                  const IndexSet            &active_set) const;
 
   private:
+    /** The scales of an iterate that decisions and residuals refer to. */
+    struct Scales
+    {
+      double force;        ///< F_∞ of DiscreteAction.
+      double force_l2;     ///< F₂ of DiscreteAction.
+      double displacement; ///< U_∞ = max|U|.
+    };
+
+    Scales
+    scales(const DiscreteAction<dim> &action,
+           const VectorType          &ghosted_solution) const;
+
     /**
      * @p active_set (owned vertices) extended to the locally relevant
      * vertices of @p action by a ghost exchange: the owner of each vertex
@@ -107,14 +271,22 @@ namespace membranes
                                 const IndexSet            &active_set) const;
 
     /**
-     * {a : Λ_a − c_a W_a > 0} for the iterate @p ghosted_solution, with
-     * Λ_a = @p lambda(k) for the k-th vertex of @p action.
+     * λ_a of the obstacle problem for w at the k-th vertex of @p action,
+     * (μ2 λ_1a + μ1 λ_2a) / (μ1 + μ2).
      */
-    template <typename LambdaOfVertex>
-    IndexSet
-    active_set_for(const DiscreteAction<dim> &action,
+    double
+    contact_lambda(const DiscreteAction<dim> &action,
+                   const unsigned int         k) const;
+
+    /**
+     * The locally owned vertices of @p action whose status in
+     * @p active_set the test wants to change, outside the band of
+     * indifference (see the class documentation).
+     */
+    std::vector<StatusChange>
+    wanted_changes(const DiscreteAction<dim> &action,
                    const VectorType          &ghosted_solution,
-                   const LambdaOfVertex      &lambda) const;
+                   const IndexSet            &active_set) const;
 
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
@@ -127,6 +299,9 @@ namespace membranes
 
     /** The linear problem of one iteration, coupled or decoupled. */
     std::unique_ptr<ActiveSetSystem<dim>> system;
+
+    /** The active sets visited on the current mesh. */
+    ActiveSetHistory history;
   };
 } // namespace membranes
 

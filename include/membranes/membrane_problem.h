@@ -61,7 +61,7 @@ namespace membranes
     void
     make_grid();
     void
-    create_output_directory() const;
+    create_output_directory(const std::string &directory) const;
     void
     setup_system();
     void
@@ -69,11 +69,17 @@ namespace membranes
     void
     solve();
     void
+    compute_lambda_h();
+    void
     postprocess();
     void
     reconstruct_fluxes();
     void
     estimate_error();
+    VectorType
+    contact_fields() const;
+    std::string
+    write_unconverged_iterate();
     void
     output_results(const unsigned int cycle);
     void

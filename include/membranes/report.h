@@ -16,8 +16,10 @@ namespace membranes
   /** Everything a run records about one cycle (one row of report.csv). */
   struct CycleRecord
   {
-    unsigned int            cycle                 = 0;
-    unsigned int            cells                 = 0;
+    unsigned int cycle = 0;
+    unsigned int cells = 0;
+    /** Levels of the mesh hierarchy: the coarse mesh and its refinements. */
+    unsigned int            levels                = 0;
     types::global_dof_index dofs                  = 0;
     unsigned int            active_set_iterations = 0;
     unsigned int            active_vertices       = 0;
