@@ -126,7 +126,11 @@ main(int argc, char **argv)
     }
   catch (const std::exception &e)
     {
-      if (running && n_processes > 1)
+      // The active set method's decision to give up is made on global
+      // quantities: every process stops there with the same message.
+      const bool on_every_process =
+        dynamic_cast<const ActiveSetNotConverged *>(&e) != nullptr;
+      if (running && n_processes > 1 && !on_every_process)
         {
           std::cerr << "membranes: error (process " << process << " of "
                     << n_processes << "): " << Parameters::one_line_message(e)

@@ -156,8 +156,8 @@ namespace membranes
   /**
    * The active set method on the current mesh. If it stops without
    * convergence, the last iterate is written by write_unconverged_iterate()
-   * and the run ends with the solver's message: no row is added to the
-   * report.
+   * and the run ends with the solver's message, the same on every process:
+   * no row is added to the report.
    */
   template <int dim>
   void
@@ -170,9 +170,9 @@ namespace membranes
       }
     catch (const ActiveSetNotConverged &error)
       {
-        throw std::runtime_error("cycle " + std::to_string(record.cycle) +
-                                 ": " + error.what() + "; " +
-                                 write_unconverged_iterate());
+        throw ActiveSetNotConverged("cycle " + std::to_string(record.cycle) +
+                                    ": " + error.what() + "; " +
+                                    write_unconverged_iterate());
       }
     ghosted_solution = solution;
 
@@ -390,8 +390,11 @@ namespace membranes
       .write(
         record.cycle, dof_handler, ghosted_solution, contact_fields(), nullptr);
     const std::string cycle = Utilities::int_to_string(record.cycle, 2);
+    const std::string fields =
+      Utilities::MPI::n_mpi_processes(mpi_communicator) == 1 ? ".vtu" : ".pvtu";
     return "the last iterate is in " + output.directory + " (solution-" +
-           cycle + ".vtu, nodal-values-" + cycle + ".csv), not in the report";
+           cycle + fields + ", nodal-values-" + cycle +
+           ".csv), not in the report";
   }
 
 

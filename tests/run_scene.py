@@ -13,18 +13,25 @@ import subprocess
 import sys
 
 
-def main():
-    if len(sys.argv) < 3:
-        sys.exit("usage: run_scene.py OUTDIR [--launcher WORDS... --] "
-                 "membranes [args...]")
-    outdir, command = sys.argv[1], sys.argv[2:]
+def scene_command(arguments):
+    """OUTDIR [--launcher WORDS... --] membranes [args...] → (OUTDIR,
+    launcher words, the command to run), with OUTDIR removed."""
+    outdir, command = arguments[0], arguments[1:]
     launcher = []
     if command[0] == "--launcher":
         end = command.index("--")
         launcher, command = command[1:end], command[end + 1:]
     shutil.rmtree(outdir, ignore_errors=True)
-    command = (launcher + command[:1] + ["--set", "Output/Directory=" + outdir]
-               + command[1:])
+    return outdir, launcher, (launcher + command[:1]
+                              + ["--set", "Output/Directory=" + outdir]
+                              + command[1:])
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit("usage: run_scene.py OUTDIR [--launcher WORDS... --] "
+                 "membranes [args...]")
+    command = scene_command(sys.argv[1:])[2]
     print(" ".join(command), flush=True)
     sys.exit(subprocess.call(command))
 
