@@ -15,7 +15,14 @@ namespace membranes
     : type(type)
     , mpi_communicator(mpi_communicator)
     , use_direct(false)
-  {}
+  {
+    if (type == Parameters::LinearSolverType::direct &&
+        Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
+      throw Parameters::invalid_entry(
+        "Solver/Linear solver",
+        "direct",
+        "UMFPACK runs on one process: use cg-amg or auto under MPI");
+  }
 
 
 
@@ -25,11 +32,6 @@ namespace membranes
   {
     const bool serial =
       (Utilities::MPI::n_mpi_processes(mpi_communicator) == 1);
-    if (type == Parameters::LinearSolverType::direct && !serial)
-      throw Parameters::invalid_entry(
-        "Solver/Linear solver",
-        "direct",
-        "UMFPACK runs on one process: use cg-amg or auto under MPI");
     use_direct = (type == Parameters::LinearSolverType::direct) ||
                  (type == Parameters::LinearSolverType::automatic && serial &&
                   dof_handler.n_dofs() <= direct_solver_dof_limit);

@@ -6,11 +6,11 @@
 Every case must end with a non-zero exit status, exactly one line on stderr
 that starts with ``membranes: error:`` and names the offending parameter, and
 no output directory. With MPI_LAUNCHER (e.g. 'mpiexec -n', completed by
-the number of processes), a triangle
-scene on two processes is a case too (only the program's own lines of
-stderr count there: the launcher adds its report of the exit status). A few good command lines (--help, --print-parameters)
-are checked as well. Prints one PASS/FAIL line per case, exits 1 on any
-failure.
+the number of processes), the scenes that only several processes refuse
+(MPI_CASES) are cases too, on two processes (only the program's own lines
+of stderr count there: the launcher adds its report of the exit status).
+A few good command lines (--help, --print-parameters) are checked as well.
+Prints one PASS/FAIL line per case, exits 1 on any failure.
 """
 import os
 import shutil
@@ -79,6 +79,16 @@ CASES = [
      None, [], ["no-such-scene.prm"]),
 ]
 
+# Scenes that only two processes refuse (same fields as CASES).
+MPI_CASES = [
+    ("triangles on two processes",
+     "subsection Geometry\n  set Cell type = triangle\nend\n", [],
+     ["Geometry/Cell type", "one process"]),
+    ("direct solver on two processes",
+     "subsection Solver\n  set Linear solver = direct\nend\n", [],
+     ["Solver/Linear solver", "one process"]),
+]
+
 
 def run(command):
     return subprocess.run(command, capture_output=True, text=True, timeout=60)
@@ -138,11 +148,9 @@ def main():
         out.write("$MeshFormat\nthis is not a mesh\n")
     results = [check_case(membranes, workdir, *case) for case in CASES]
     if len(sys.argv) > 3:
-        results.append(check_case(
-            membranes, workdir, "triangles on two processes",
-            "subsection Geometry\n  set Cell type = triangle\nend\n", [],
-            ["Geometry/Cell type", "one process"],
-            launcher=sys.argv[3].split() + ["2"]))
+        launcher = sys.argv[3].split() + ["2"]
+        results += [check_case(membranes, workdir, *case, launcher=launcher)
+                    for case in MPI_CASES]
     results.append(check_good_command_lines(membranes))
     print("%d passed, %d failed" % (results.count(True), results.count(False)))
     sys.exit(0 if all(results) else 1)

@@ -45,6 +45,10 @@ namespace membranes
     /** Largest problem that `auto` hands to UMFPACK. */
     static constexpr types::global_dof_index direct_solver_dof_limit = 10000;
 
+    /**
+     * Throws if @p type is `direct` on more than one process (UMFPACK is
+     * serial); this happens before the run, on every process alike.
+     */
     LinearSolver(const Parameters::LinearSolverType type,
                  const MPI_Comm                     mpi_communicator);
 
