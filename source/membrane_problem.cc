@@ -540,6 +540,17 @@ namespace membranes
         reconstruct_fluxes();
         estimate_error();
 
+        // On several processes a phase lasts as long as its slowest process
+        // (each ends in communication): report that one's time.
+        for (double *time : {&record.time_setup,
+                             &record.time_assembly,
+                             &record.time_solve,
+                             &record.time_postprocess,
+                             &record.time_estimate})
+          *time = Utilities::MPI::max(*time, mpi_communicator);
+        if (record.time_flux)
+          record.time_flux =
+            Utilities::MPI::max(*record.time_flux, mpi_communicator);
         record.wall_time = record.time_setup + record.time_assembly +
                            record.time_solve + record.time_postprocess +
                            record.time_estimate +
