@@ -49,24 +49,27 @@ namespace membranes
 
 
   template <int dim>
-  void
+  std::vector<std::string>
   FieldOutput<dim>::write(const unsigned int     cycle,
                           const DoFHandler<dim> &dof_handler,
                           const VectorType      &ghosted_solution,
                           const VectorType      &contact_fields,
                           const Vector<double>  *indicators)
   {
+    std::vector<std::string> files;
     if (parameters.write_vtu)
-      write_vtu(
-        cycle, dof_handler, ghosted_solution, contact_fields, indicators);
+      files.push_back(write_vtu(
+        cycle, dof_handler, ghosted_solution, contact_fields, indicators));
     if (parameters.write_nodal_values)
-      write_nodal_values(cycle, dof_handler, ghosted_solution, contact_fields);
+      files.push_back(write_nodal_values(
+        cycle, dof_handler, ghosted_solution, contact_fields));
+    return files;
   }
 
 
 
   template <int dim>
-  void
+  std::string
   FieldOutput<dim>::write_vtu(const unsigned int     cycle,
                               const DoFHandler<dim> &dof_handler,
                               const VectorType      &ghosted_solution,
@@ -106,6 +109,7 @@ namespace membranes
         data_out.write_pvtu_record(out, pieces);
       },
       cycles_written);
+    return cycles_written.back().second;
   }
 
 
@@ -180,7 +184,7 @@ namespace membranes
 
 
   template <int dim>
-  void
+  std::string
   FieldOutput<dim>::write_nodal_values(const unsigned int     cycle,
                                        const DoFHandler<dim> &dof_handler,
                                        const VectorType      &ghosted_solution,
@@ -210,22 +214,23 @@ namespace membranes
       rows.push_back(row);
 
     // All of them on the first process, in the order of their positions.
+    const std::string file =
+      "nodal-values-" + Utilities::int_to_string(cycle, 2) + ".csv";
     const auto gathered = Utilities::MPI::gather(mpi_communicator, rows, 0);
     if (Utilities::MPI::this_mpi_process(mpi_communicator) != 0)
-      return;
+      return file;
     rows.clear();
     for (const auto &process_rows : gathered)
       rows.insert(rows.end(), process_rows.begin(), process_rows.end());
     std::sort(rows.begin(), rows.end());
 
-    const std::string name = parameters.directory + "/nodal-values-" +
-                             Utilities::int_to_string(cycle, 2) + ".csv";
-    write_atomically(name, [&](std::ostream &out) {
+    write_atomically(parameters.directory + "/" + file, [&](std::ostream &out) {
       out << std::setprecision(17) << "x,y,u1,u2,lambda_h,active_set\n";
       for (const auto &row : rows)
         out << row[0] << ',' << row[1] << ',' << row[2] << ',' << row[3] << ','
             << row[4] << ',' << row[5] << '\n';
     });
+    return file;
   }
 
 

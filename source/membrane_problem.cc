@@ -386,15 +386,15 @@ namespace membranes
     output.write_vtu          = true;
     output.write_nodal_values = true;
     create_output_directory(output.directory);
-    FieldOutput<dim>(output, discretization, mpi_communicator)
-      .write(
-        record.cycle, dof_handler, ghosted_solution, contact_fields(), nullptr);
-    const std::string cycle = Utilities::int_to_string(record.cycle, 2);
-    const std::string fields =
-      Utilities::MPI::n_mpi_processes(mpi_communicator) == 1 ? ".vtu" : ".pvtu";
-    return "the last iterate is in " + output.directory + " (solution-" +
-           cycle + fields + ", nodal-values-" + cycle +
-           ".csv), not in the report";
+    const std::vector<std::string> files =
+      FieldOutput<dim>(output, discretization, mpi_communicator)
+        .write(record.cycle,
+               dof_handler,
+               ghosted_solution,
+               contact_fields(),
+               nullptr);
+    return "the last iterate is in " + output.directory + " (" + files[0] +
+           ", " + files[1] + "), not in the report";
   }
 
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Run a scene that must fail::
 
-    run_failing_scene.py OUTDIR WORDS [--launcher WORDS... --] membranes [args...]
+    run_failing_scene.py OUTDIR WORDS [--launcher LAUNCHER... --] membranes [args...]
 
 As run_scene.py (OUTDIR removed first and passed as ``Output/Directory``,
 an optional MPI launcher), but the run passes if it ends with exit status 1
@@ -19,9 +19,9 @@ from run_scene import scene_command
 def main():
     if len(sys.argv) < 4:
         sys.exit("usage: run_failing_scene.py OUTDIR WORDS "
-                 "[--launcher WORDS... --] membranes [args...]")
+                 "[--launcher LAUNCHER... --] membranes [args...]")
     words = sys.argv[2].split("|")
-    _, launcher, command = scene_command(sys.argv[1:2] + sys.argv[3:])
+    launcher, command = scene_command(sys.argv[1:2] + sys.argv[3:])
     print(" ".join(command), flush=True)
     result = subprocess.run(command, stderr=subprocess.PIPE, text=True)
     lines = [line for line in result.stderr.splitlines()

@@ -14,24 +14,23 @@ import sys
 
 
 def scene_command(arguments):
-    """OUTDIR [--launcher WORDS... --] membranes [args...] → (OUTDIR,
-    launcher words, the command to run), with OUTDIR removed."""
+    """OUTDIR [--launcher WORDS... --] membranes [args...] → (launcher
+    words, the command to run), with OUTDIR removed."""
     outdir, command = arguments[0], arguments[1:]
     launcher = []
     if command[0] == "--launcher":
         end = command.index("--")
         launcher, command = command[1:end], command[end + 1:]
     shutil.rmtree(outdir, ignore_errors=True)
-    return outdir, launcher, (launcher + command[:1]
-                              + ["--set", "Output/Directory=" + outdir]
-                              + command[1:])
+    return launcher, (launcher + command[:1]
+                      + ["--set", "Output/Directory=" + outdir] + command[1:])
 
 
 def main():
     if len(sys.argv) < 3:
         sys.exit("usage: run_scene.py OUTDIR [--launcher WORDS... --] "
                  "membranes [args...]")
-    command = scene_command(sys.argv[1:])[2]
+    command = scene_command(sys.argv[1:])[1]
     print(" ".join(command), flush=True)
     sys.exit(subprocess.call(command))
 

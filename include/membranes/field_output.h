@@ -48,9 +48,10 @@ namespace membranes
      * the layout of the solution and holds λ_a in the u1 slot and the active
      * set indicator (1 or 0) in the u2 slot of every vertex; all vectors are
      * ghosted. The error indicators η_K (one per active cell) are written to
-     * VTU when given.
+     * VTU when given. Returns the names of the files written, relative to
+     * the output directory: solution-NN.vtu (or .pvtu), nodal-values-NN.csv.
      */
-    void
+    std::vector<std::string>
     write(const unsigned int     cycle,
           const DoFHandler<dim> &dof_handler,
           const VectorType      &ghosted_solution,
@@ -84,16 +85,22 @@ namespace membranes
                                const std::vector<std::string> &)> &write_record,
       std::vector<std::pair<double, std::string>>                 &written);
 
-    /** solution-NN.vtu (or .pvtu and pieces) and solution.pvd. */
-    void
+    /**
+     * solution-NN.vtu (or .pvtu and pieces) and solution.pvd; returns the
+     * name of the first.
+     */
+    std::string
     write_vtu(const unsigned int     cycle,
               const DoFHandler<dim> &dof_handler,
               const VectorType      &ghosted_solution,
               const VectorType      &contact_fields,
               const Vector<double>  *indicators);
 
-    /** nodal-values-NN.csv: position, u1, u2, λ_a, active set per vertex. */
-    void
+    /**
+     * nodal-values-NN.csv: position, u1, u2, λ_a, active set per vertex;
+     * returns its name.
+     */
+    std::string
     write_nodal_values(const unsigned int     cycle,
                        const DoFHandler<dim> &dof_handler,
                        const VectorType      &ghosted_solution,
