@@ -307,7 +307,7 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          flux_reconstruction.lambda_h_values(cell, lambda);
+          flux_reconstruction.nodal_lambda_values(fe_values, lambda);
           const double h_K  = cell->diameter();
           double       eta2 = 0;
           for (unsigned int i = 0; i < 2; ++i)

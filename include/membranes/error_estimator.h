@@ -55,9 +55,9 @@ namespace membranes
    * with hanging nodes.
    *
    * <h3>The flux estimator</h3>
-   * Built on the flux reconstructions t_ih of
-   * §4.2 (in the spirit of Part 2 of the paper and of Dabaghi, Martin and
-   * Vohralík for this problem).
+   * Built on the equilibrated fluxes σ_ih of FluxReconstruction, on the
+   * sub-mesh S_h of §4.2 (in the spirit of Part 2 of the paper and of
+   * Dabaghi, Martin and Vohralík for this problem).
    *
    * Let e_i = u_i − u_ih, |||e|||² = Σ_i μ_i |e_i|²_{H1}, s_1 = +1,
    * s_2 = −1, and σ_i ∈ H(div, ω) any flux. From −μ_i Δu_i = f_i + s_i λ,
@@ -83,27 +83,24 @@ namespace membranes
    * The flux t_ih of (4.13) has this property only on whole dual cells
    * (Lemma 17, up to data oscillation): div t_ih varies from one
    * sub-triangle of D_a to the next by O(|∇²u|), which would make η_R as
-   * large as η_F (measured: twice as large on case M). The estimator
-   * therefore uses σ_ih = t_ih + δ_ih, the equilibrated flux of
-   * FluxReconstruction: δ_ih lives in RT0 of the sub-triangles of D_a with
-   * zero normal flux on ∂D_a (so the fluxes (4.13) through ∂D_a, and with
-   * them (4.18) and the balance of Lemma 17, are those of t_ih) and makes
-   * ∫_κ div σ_ih = ∫_κ (f_i + s_i λ_h) + γ_a |κ| on every sub-triangle κ,
-   * with the constant γ_a that the compatibility on D_a requires (data
-   * oscillation, zero for loads that are constant on cells). Then r_i is
-   * f_i minus its means, of the order of h ∇f, and η_R is of higher order.
-   * On the dual cells of boundary vertices, which make up the strip
-   * ω \ ω_h and where e_i vanishes on ∂ω (Friedrichs instead of Poincaré),
-   * the same construction needs no γ. The 1/π of convex cells with the
-   * cell diameter h_K is used as the constant; η is an upper bound up to
-   * this choice of constant, the data oscillation γ_a and the
-   * interpolation of the boundary data g.
+   * large as η_F. The estimator therefore uses the equilibrated flux σ_ih
+   * of FluxReconstruction, the sum of patch contributions on the supports
+   * of the hat functions: div σ_ih = Π_0 (f_i + s_i λ̃_h) on every
+   * sub-triangle of S_h, with λ̃_h = Σ_a λ_a φ_a the P1/Q1 function of the
+   * nodal λ_a. The argument above holds with λ̃_h in place of λ_h (it only
+   * uses λ_h ≥ 0), so the residual and contact terms use λ̃_h; r_i is then
+   * f_i + s_i λ̃_h minus its means on the sub-triangles, of the order of
+   * h ∇(f_i + s_i λ̃_h), and η_R is of higher order. The 1/π of convex
+   * cells with the cell diameter h_K is used as the constant (the means
+   * of r_i vanish on every sub-triangle, hence on every cell); η is an
+   * upper bound up to this choice of constant and the interpolation of
+   * the boundary data g (e_i does not vanish on ∂ω where g ≠ I_h g).
    *
    * For marking, per cell K,
    *
    *   η_K² = Σ_i μ_i^{-1} (‖μ_i ∇u_ih + σ_ih‖_K
-   *                        + (h_K/π) ‖f_i + s_i λ_h − div σ_ih‖_K)²
-   *          + 2 (λ_h, u1h − u2h)⁺_K,
+   *                        + (h_K/π) ‖f_i + s_i λ̃_h − div σ_ih‖_K)²
+   *          + 2 (λ̃_h, u1h − u2h)⁺_K,
    *
    * whose sum is at most η² (Minkowski).
    */

@@ -156,17 +156,56 @@ namespace membranes
    * fine side's exactly when the density is the same on both halves of e.
    *
    * <h3>The equilibrated flux σ_ih</h3>
-   * For the flux estimator (see ErrorEstimator), σ_ih = t_ih + δ_ih, with
-   * δ_ih ∈ RT0 of the sub-triangles of D_a, zero normal flux on ∂D_a, and
-   * ∫_κ div σ_ih = ∫_κ (f_i + s_i λ_h) + γ_a |κ| on each of them. Around a
-   * the sub-triangles form a fan, neighbours sharing an edge through a;
-   * with y_j the flux of δ_ih from κ_j into κ_{j+1}, the conditions read
-   * y_j − y_{j−1} = r_j: the y_j are y_0 plus partial sums, γ_a makes them
-   * close around an interior vertex (Σ_j r_j = 0), and y_0 minimizes
-   * ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on D_a. On the dual cell of a
-   * boundary vertex the fan is open at ∂ω (no γ_a is needed). An edge
-   * with a hanging node cuts the fan (δ_ih = 0 there, so that σ_ih stays
-   * conforming), with a γ for each piece of the fan.
+   * For the flux estimator (see ErrorEstimator) the fluxes are
+   * equilibrated patch by patch on the primal mesh (Braess and Schöberl;
+   * Ern and Vohralík), with RT0 on the sub-mesh S_h:
+   *
+   *   σ_ih = Σ_a σ_ih^a,
+   *
+   * the sum over all vertices a that carry a degree of freedom (interior,
+   * on ∂ω, not hanging), each σ_ih^a ∈ RT0(S_h) living on the support ω_a
+   * of the condensed hat function φ_a (φ_a plus the constraint weights of
+   * the hanging vertices with parent a, so that Σ_a φ_a = 1) with
+   *
+   *   ∫_κ div σ_ih^a = ∫_κ r_ia,  r_ia = (f_i + s_i λ_a) φ_a
+   *                                      − μ_i ∇u_ih·∇φ_a,
+   *
+   * on every sub-triangle κ (s_1 = 1, s_2 = −1), zero normal flux on
+   * ∂ω_a inside ω, and on ∂ω the normal flux of −μ_i φ_a ∇u_ih plus what
+   * ∫ r_ia leaves over, spread over the half-edges of ∂ω ∩ ∂ω_a in
+   * proportion to ∫ φ_a on them. Around an interior vertex the patch
+   * problem is solvable because ∫ r_ia = 0 is (4.5) for the condensed φ_a
+   * (quadrature and solver leave O(round-off), spread as a constant). Then
+   *
+   *   div σ_ih = Π_0 (f_i + s_i λ̃_h)  on every κ,  λ̃_h = Σ_a λ_a φ_a,
+   *
+   * the P1/Q1 function with the nodal values λ_a (λ̃_h ≥ 0; the estimator
+   * uses it in its residual and contact terms). Among these fields σ_ih^a
+   * minimizes, in L², the distance to the RT0 field T_ia with the fluxes
+   * of −μ_i φ_a ∇u_ih through the edges of S_h (through a half-edge
+   * between two cells the mean of both sides). The T_ia add up to a
+   * conforming field, and where u_ih is linear they satisfy the
+   * constraints themselves: then σ_ih^a = T_ia and σ_ih = −μ_i ∇u_ih
+   * exactly, which the tests check. (Minimizing the distance to
+   * −μ_i φ_a ∇u_ih itself instead loses this: the sum of the patch
+   * minimizers is then off by O(|∇u_ih|) in a strip of cells along ∂ω
+   * and wherever the mesh changes direction, an effectivity that grows
+   * like h^{−1/2}.) At an edge with a hanging node the two halves on the
+   * fine side carry the same flux density (one unknown), which keeps
+   * σ_ih conforming but not exact for linear u_ih there.
+   *
+   * On each cell the sub-triangles form a ring around b_K; with the
+   * fluxes through their half-edges and one circulation per cell, the
+   * divergence constraints inside the cell are solved in closed form, so a
+   * patch problem is a small saddle point system: 15 (Q1) to 23 (P1)
+   * unknowns around a regular interior vertex.
+   *
+   * On several processes the support of a condensed φ_a can reach beyond
+   * the ghost layer of a process that owns one of its cells. Each process
+   * therefore writes, for its owned cells, what the patch problems need
+   * into records of plain numbers (with process-independent keys for the
+   * shared half-edges), sends them to the owner of a, which solves the
+   * patch problem and sends σ_ih^a back (Utilities::MPI::some_to_some).
    *
    * <h3>Quadrilaterals</h3>
    * The construction is the same on the pieces of Q1 cells, with the
@@ -233,6 +272,15 @@ namespace membranes
                     std::vector<bool>   *in_omega_h = nullptr) const;
 
     /**
+     * The P1/Q1 function λ̃_h = Σ_a λ_a φ_a with the nodal values λ_a of
+     * λ_h (zero on ∂ω; at a hanging vertex the constraint-weighted mean),
+     * at the points of @p fe_values, reinit'ed on a cell.
+     */
+    void
+    nodal_lambda_values(const FEValues<dim> &fe_values,
+                        std::vector<double> &values) const;
+
+    /**
      * Compute t_1h, t_2h for @p ghosted_solution on the locally owned cells,
      * and the defects of the identities against the λ_a of @p action.
      */
@@ -291,14 +339,26 @@ namespace membranes
       std::array<std::array<double, 3>, 3> gram{};
       /** (μ_i ∇u_ih, ψ_k)_κ. */
       std::array<std::array<double, 3>, 2> discrete_flux{};
-      /** ∫_κ f_i and ∫_κ (f_i + s_i λ_h), s_1 = 1, s_2 = −1. */
-      std::array<double, 2> load{}, source{};
+      /** ∫_κ f_i. */
+      std::array<double, 2> load{};
       double                area = 0;
     };
 
-    /** Ends of a chain of sub-triangles around a vertex (see links). */
-    static constexpr unsigned int free_end = numbers::invalid_unsigned_int;
-    static constexpr unsigned int zero_end = numbers::invalid_unsigned_int - 1;
+    /**
+     * The terms of the patch problems on one sub-triangle κ: for the hat
+     * function φ_v of each vertex v of the cell ∫_κ (f_i φ_v −
+     * μ_i ∇u_ih·∇φ_v) and ∫_κ φ_v; at the two Gauss points of each edge of
+     * κ the weighted flux density μ_i ∇u_ih·n ds; and the weighted length
+     * ds at those of edge 2 if it lies on ∂ω. Kept only while
+     * reconstruct() runs.
+     */
+    struct PatchTerms
+    {
+      std::array<std::array<double, 4>, 2>                hat_residual{};
+      std::array<double, 4>                               hat_mass{};
+      std::array<std::array<std::array<double, 2>, 3>, 2> edge_flux{};
+      std::array<double, 2>                               boundary_length{};
+    };
 
     /** λ_h on the pieces of vertex @p v of @p cell. */
     double
@@ -310,23 +370,47 @@ namespace membranes
                    const std::array<double, 3> &fluxes,
                    const Point<dim>            &x) const;
 
-    /** σ_ih = t_ih + δ_ih on every dual cell (see the class comment). */
-    void
-    equilibrate();
-
     /**
-     * σ_ih on one chain of sub-triangles around a vertex, each given with
-     * the slot (0: edge 1, 1: edge 2) through which the chain enters it.
-     * @p free_entry: the flux y_0 of δ_ih through the first entry edge is
-     * free (a closed fan, or an end on ∂ω), not zero (an edge with a
-     * hanging node). @p closed: the chain closes up, or ends at an edge with
-     * a hanging node as well, so that a constant γ balances it.
+     * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch
+     * problems on the supports of the condensed hat functions φ_a (see the
+     * class comment), each solved by the owner of a on the records of its
+     * cells, with @p patch_terms from reconstruct().
      */
     void
-    equilibrate_chain(
-      const std::vector<std::pair<unsigned int, unsigned int>> &chain,
-      const bool                                                free_entry,
-      const bool                                                closed);
+    equilibrate(const std::vector<PatchTerms>   &patch_terms,
+                const AffineConstraints<double> &hanging_node_constraints,
+                const IndexSet                  &locally_owned_dofs,
+                const MPI_Comm                   mpi_communicator);
+
+    /**
+     * Write the record of the sub-triangles of @p cell (in the order of
+     * ring) for the patch problem of the condensed hat function with
+     * @p coefficients on @p cell to @p record.
+     */
+    void
+    write_patch_record(const CellIterator            &cell,
+                       const std::array<double, 4>   &coefficients,
+                       const std::vector<PatchTerms> &patch_terms,
+                       double                        *record) const;
+
+    /**
+     * The patch problem of vertex @p a on the records @p patch of the
+     * cells of the support of φ_a: writes the fluxes of σ_ih^a through the
+     * three edges of each sub-triangle, per i, to @p result; @p scratch
+     * holds work arrays from one call to the next.
+     */
+    struct PatchScratch;
+
+    void
+    solve_patch_problem(const types::global_dof_index      a,
+                        const std::vector<const double *> &patch,
+                        const std::vector<double *>       &result,
+                        PatchScratch                      &scratch) const;
+
+    /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
+    void
+    add_patch_result(const CellIterator &cell, const double *result);
+
     const Discretization<dim>    &discretization;
     const ProblemData<dim>       &data;
     const DualCellQuadrature<dim> dual_cell_quadrature;
@@ -338,14 +422,16 @@ namespace membranes
     /** By active cell index × sub-triangles per cell + sub-triangle. */
     std::vector<SubTriangleData> sub_triangle_data;
     /**
-     * The neighbours of each sub-triangle in the fan around its vertex a:
-     * across edge 1 (a–b_K, the other half of the piece) and across edge 2
-     * (a–m_e, in the neighbour cell), or free_end (on ∂ω) or zero_end (on
-     * an edge with a hanging node).
+     * The sub-triangles of a cell in the order of the ring they form
+     * around b_K: ring[j] and ring[j+1] share edge 0 (m_e–b_K) of ring[j]
+     * for even j, edge 1 (a–b_K) for odd j; the last closes the ring.
      */
-    std::vector<std::array<unsigned int, 2>> links;
-    /** The sub-triangles of every vertex's dual cell. */
-    std::vector<std::vector<unsigned int>> vertex_sub_triangles;
+    std::vector<unsigned int> ring;
+    /**
+     * The hat function of vertex v at Gauss point k of edge e of
+     * sub-triangle s, at ((s · 3 + e) · 2 + k) · 4 + v.
+     */
+    std::vector<double> edge_shape_values;
     /** f_1, f_2 at the points of the dual quadrature, cell by cell. */
     std::vector<double> load_at_points;
     Identities          defects;
