@@ -167,6 +167,15 @@ namespace membranes
 
 
 
+    /** The work arrays of solve_saddle_point(). */
+    struct SaddlePointScratch
+    {
+      FullMatrix<double>  L, S;
+      std::vector<double> Z, y;
+    };
+
+
+
     /**
      * Solve the saddle point system [A Bᵀ; B 0] (x; y) = (b; c) with
      * A (n × n) symmetric positive definite and B (n_c × n) of full rank,
@@ -175,12 +184,6 @@ namespace membranes
      * A and of the Schur complement S = B A⁻¹ Bᵀ. Returns false if a
      * pivot is not positive (the system is then left to an LU solver).
      */
-    struct SaddlePointScratch
-    {
-      FullMatrix<double>  L, S;
-      std::vector<double> Z, y;
-    };
-
     bool
     solve_saddle_point(const FullMatrix<double>      &K,
                        const unsigned int             n,
@@ -527,8 +530,6 @@ namespace membranes
     free_flux_index.reserve(n_cells * n_triangles);
     free_fluxes.reserve(n_cells * n_triangles);
     load_at_points.assign(2 * n_cells * points.n_volume, 0.);
-    std::vector<double>     hat_integrals(n_cells *
-                                      GeometryInfo<dim>::vertices_per_cell);
     std::vector<PatchTerms> patch_terms(n_cells * n_triangles);
 
     // The owned and the ghost cells: the cells along every half-edge of an
@@ -557,15 +558,6 @@ namespace membranes
                           (2 * cell->active_cell_index() + i) *
                             points.n_volume);
             }
-          // ∫_K φ_v, for f_ih ∫_K φ_v in the balance of Lemma 17.
-          for (const unsigned int v : cell->vertex_indices())
-            for (unsigned int q = 0; q < points.n_volume; ++q)
-              hat_integrals[cell->active_cell_index() *
-                              GeometryInfo<dim>::vertices_per_cell +
-                            v] +=
-                fe_values.shape_value(fe.component_to_system_index(0, v), q) *
-                fe_values.JxW(q);
-
           for (unsigned int s = 0; s < n_triangles; ++s)
             {
               const auto        &triangle = triangles[s];
@@ -601,6 +593,52 @@ namespace membranes
                     if (owned && e == 2 && cell->at_boundary(triangle.face))
                       terms.boundary_length[k] = n_ds.norm();
                   }
+
+              // The unknown of the half-edge a–m_e in the patch problems:
+              // the half-edge itself, or on an edge with a hanging node the
+              // small edge that holds it (with factor 1 from the coarse
+              // side, 1/2 for each of the two half-edges on the fine side).
+              // Its key is the midpoint of that segment, computed alike on
+              // every cell and every process.
+              if (owned)
+                {
+                  const unsigned int f          = triangle.face;
+                  auto               face       = cell->face(f);
+                  double             factor     = 1;
+                  bool               small_edge = false;
+                  if (!cell->at_boundary(f) && face->has_children())
+                    {
+                      const unsigned int vertex =
+                        cell->vertex_index(triangle.vertex);
+                      const auto first = face->child(0);
+                      face = face->child(first->vertex_index(0) == vertex ||
+                                             first->vertex_index(1) == vertex ?
+                                           0 :
+                                           1);
+                      small_edge = true;
+                    }
+                  else if (!cell->at_boundary(f) &&
+                           cell->neighbor_is_coarser(f))
+                    {
+                      factor     = 0.5;
+                      small_edge = true;
+                    }
+                  Point<dim> first = face->vertex(0), second = face->vertex(1);
+                  if (std::make_pair(second[0], second[1]) <
+                      std::make_pair(first[0], first[1]))
+                    std::swap(first, second);
+                  const Point<dim> middle = (first + second) / 2;
+                  const Point<dim> key =
+                    small_edge ? middle :
+                                 (cell->vertex(triangle.vertex) + middle) / 2;
+                  terms.key         = {{key[0], key[1]}};
+                  terms.factor      = (cross_product_2d(second - first) *
+                                        (middle - cell->center()) >
+                                      0 ?
+                                         factor :
+                                         -factor);
+                  terms.on_boundary = cell->at_boundary(f);
+                }
 
               // The Gram matrix of the mapped basis ψ_k, (μ_i ∇u_ih, ψ_k),
               // the area, ∫ f_i, and the hat function terms on κ.
@@ -741,11 +779,13 @@ namespace membranes
                 const auto k = fe.component_to_system_index(i, v);
                 local_load_on_pieces(k) =
                   load_mean[i] / area * local_measure(k);
-                local_load_on_hats(k) =
-                  load_mean[i] / area *
-                  hat_integrals[cell->active_cell_index() *
-                                  GeometryInfo<dim>::vertices_per_cell +
-                                v];
+                // f_ih ∫_K φ_v, with ∫_K φ_v from the patch terms.
+                double hat_integral = 0;
+                for (unsigned int s = 0; s < n_triangles; ++s)
+                  hat_integral +=
+                    patch_terms[cell->active_cell_index() * n_triangles + s]
+                      .hat_mass[v];
+                local_load_on_hats(k) = load_mean[i] / area * hat_integral;
               }
           hanging_node_constraints.distribute_local_to_global(local_measure,
                                                               dof_indices,
@@ -889,54 +929,19 @@ namespace membranes
     double                        *record) const
   {
     using namespace PatchRecord;
-    const auto        &triangles   = dual_cell_quadrature.sub_triangles();
-    const unsigned int n_triangles = triangles.size();
+    const unsigned int n_triangles =
+      dual_cell_quadrature.sub_triangles().size();
     for (unsigned int j = 0; j < ring.size(); ++j, record += size)
       {
         const unsigned int id =
           cell->active_cell_index() * n_triangles + ring[j];
-        const SubTriangleData &kappa    = sub_triangle_data[id];
-        const PatchTerms      &terms    = patch_terms[id];
-        const auto            &triangle = triangles[ring[j]];
-        const unsigned int     f        = triangle.face;
+        const SubTriangleData &kappa = sub_triangle_data[id];
+        const PatchTerms      &terms = patch_terms[id];
 
-        // The unknown of the half-edge a–m_e: the half-edge itself, or on
-        // an edge with a hanging node the small edge that holds it (with
-        // factor 1 from the coarse side, 1/2 for each of the two
-        // half-edges on the fine side). Its key is the midpoint of that
-        // segment, computed alike on every cell and every process.
-        auto   face             = cell->face(f);
-        double factor           = 1;
-        bool   whole_small_edge = false;
-        if (!cell->at_boundary(f) && face->has_children())
-          {
-            const unsigned int vertex = cell->vertex_index(triangle.vertex);
-            const auto         first  = face->child(0);
-            face             = face->child(first->vertex_index(0) == vertex ||
-                                   first->vertex_index(1) == vertex ?
-                                 0 :
-                                 1);
-            whole_small_edge = true;
-          }
-        else if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
-          {
-            factor           = 0.5;
-            whole_small_edge = true;
-          }
-        Point<dim> first = face->vertex(0), second = face->vertex(1);
-        if (std::make_pair(second[0], second[1]) <
-            std::make_pair(first[0], first[1]))
-          std::swap(first, second);
-        const Point<dim>     middle = (first + second) / 2;
-        const Point<dim>     key    = whole_small_edge ?
-                                        middle :
-                                        (cell->vertex(triangle.vertex) + middle) / 2;
-        const Tensor<1, dim> normal = cross_product_2d(second - first);
-        record[key_x]               = key[0];
-        record[key_y]               = key[1];
-        record[PatchRecord::factor] =
-          (normal * (middle - cell->center()) > 0 ? factor : -factor);
-        record[on_boundary] = cell->at_boundary(f) ? 1 : 0;
+        record[key_x]               = terms.key[0];
+        record[key_y]               = terms.key[1];
+        record[PatchRecord::factor] = terms.factor;
+        record[on_boundary]         = terms.on_boundary ? 1 : 0;
         for (unsigned int k = 0, n = 0; k < 3; ++k)
           for (unsigned int l = k; l < 3; ++l, ++n)
             record[gram + n] = kappa.gram[k][l];

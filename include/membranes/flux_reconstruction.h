@@ -349,8 +349,8 @@ namespace membranes
      * function φ_v of each vertex v of the cell ∫_κ (f_i φ_v −
      * μ_i ∇u_ih·∇φ_v) and ∫_κ φ_v; at the two Gauss points of each edge of
      * κ the weighted flux density μ_i ∇u_ih·n ds; and the weighted length
-     * ds at those of edge 2 if it lies on ∂ω. Kept only while
-     * reconstruct() runs.
+     * ds at those of edge 2 if it lies on ∂ω; the key of its half-edge.
+     * Kept only while reconstruct() runs.
      */
     struct PatchTerms
     {
@@ -358,6 +358,14 @@ namespace membranes
       std::array<double, 4>                               hat_mass{};
       std::array<std::array<std::array<double, 2>, 3>, 2> edge_flux{};
       std::array<double, 2>                               boundary_length{};
+      /**
+       * The key of the unknown flux through edge 2 of κ (a point), the
+       * factor that gives κ's outward flux from it, and whether edge 2
+       * lies on ∂ω (see write_patch_record()).
+       */
+      std::array<double, 2> key{};
+      double                factor      = 0;
+      bool                  on_boundary = false;
     };
 
     /** λ_h on the pieces of vertex @p v of @p cell. */
