@@ -32,6 +32,7 @@ namespace membranes
     std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
     std::vector<double>                        lambda(n_q_points), lambda_h;
     std::vector<bool>                          in_omega_h;
+    std::vector<double>                        local_dofs(fe.n_dofs_per_cell());
     for (unsigned int i = 0; i < 2; ++i)
       {
         uh[i].resize(n_q_points);
@@ -46,15 +47,19 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
+          cell->get_dof_values(ghosted_solution,
+                               local_dofs.begin(),
+                               local_dofs.end());
           flux_reconstruction.lambda_h_values(cell, lambda_h, &in_omega_h);
           data.set_gradient_step(1e-4 * cell->diameter());
           const auto &points = fe_values.get_quadrature_points();
           for (unsigned int i = 0; i < 2; ++i)
             {
               const FEValuesExtractors::Scalar membrane(i);
-              fe_values[membrane].get_function_values(ghosted_solution, uh[i]);
-              fe_values[membrane].get_function_gradients(ghosted_solution,
-                                                         grad_uh[i]);
+              fe_values[membrane].get_function_values_from_local_dof_values(
+                local_dofs, uh[i]);
+              fe_values[membrane].get_function_gradients_from_local_dof_values(
+                local_dofs, grad_uh[i]);
               data.exact_displacement(i).value_list(points, u[i]);
               data.exact_displacement(i).gradient_list(points, grad_u[i]);
             }

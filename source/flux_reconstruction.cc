@@ -436,16 +436,25 @@ namespace membranes
                                            std::vector<double> &values,
                                            std::vector<bool> *in_omega_h) const
   {
+    // λ_h is constant on the pieces of each vertex: look it up once per
+    // vertex, not once per point.
+    std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
+    std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
+    for (const unsigned int v : cell->vertex_indices())
+      {
+        vertex_values[v] = lambda_h_value(cell, v);
+        vertex_in_omega_h[v] =
+          dual_mesh_vertices.is_element(cell->vertex_dof_index(v, 0));
+      }
     values.resize(dual_cell_quadrature.quadrature().size());
     if (in_omega_h)
       in_omega_h->resize(values.size());
     for (unsigned int q = 0; q < values.size(); ++q)
       {
         const unsigned int v = dual_cell_quadrature.vertex_of_point(q);
-        values[q]            = lambda_h_value(cell, v);
+        values[q]            = vertex_values[v];
         if (in_omega_h)
-          (*in_omega_h)[q] =
-            dual_mesh_vertices.is_element(cell->vertex_dof_index(v, 0));
+          (*in_omega_h)[q] = vertex_in_omega_h[v];
       }
   }
 

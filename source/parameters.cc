@@ -589,6 +589,17 @@ namespace membranes::Parameters
                       "0",
                       dealii::Patterns::Anything(),
                       "Exact action lambda of membrane 2 on membrane 1.");
+    prm.declare_entry("u1 gradient",
+                      "",
+                      dealii::Patterns::Anything(),
+                      "Gradient of the exact u1 as two expressions separated "
+                      "by ';', the derivatives by x and by y (e.g. '2*x; "
+                      "2*y' for u1 = x^2 + y^2), for the H1 errors; empty: "
+                      "central finite differences of u1.");
+    prm.declare_entry("u2 gradient",
+                      "",
+                      dealii::Patterns::Anything(),
+                      "Gradient of the exact u2, likewise.");
     prm.leave_subsection();
   }
 
@@ -596,10 +607,12 @@ namespace membranes::Parameters
   ExactSolution::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Exact solution");
-    known  = prm.get_bool("Known");
-    u1     = prm.get("u1");
-    u2     = prm.get("u2");
-    lambda = prm.get("lambda");
+    known       = prm.get_bool("Known");
+    u1          = prm.get("u1");
+    u2          = prm.get("u2");
+    lambda      = prm.get("lambda");
+    u1_gradient = prm.get("u1 gradient");
+    u2_gradient = prm.get("u2 gradient");
     prm.leave_subsection();
   }
 
@@ -610,11 +623,14 @@ namespace membranes::Parameters
   {
     prm.enter_subsection("Solver");
     prm.declare_entry("Method",
-                      "coupled",
-                      Selection("coupled|decoupled"),
+                      "auto",
+                      Selection("auto|coupled|decoupled"),
                       "coupled: active set method on (u1, u2); decoupled: "
                       "linear problem for s = mu1 u1 + mu2 u2 and obstacle "
-                      "problem for w = u1 - u2.");
+                      "problem for w = u1 - u2; auto: the faster of the two "
+                      "for the scene (decoupled, half the size, for constant "
+                      "tensions); coupled and decoupled give the same "
+                      "discrete solution.");
     prm.declare_entry("Linear solver",
                       "auto",
                       Selection("auto|direct|cg-amg"),
@@ -637,8 +653,10 @@ namespace membranes::Parameters
   Solver::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Solver");
-    method = (prm.get("Method") == "decoupled" ? SolverMethod::decoupled :
-                                                 SolverMethod::coupled);
+    const std::string m       = prm.get("Method");
+    method                    = (m == "coupled"   ? SolverMethod::coupled :
+                                 m == "decoupled" ? SolverMethod::decoupled :
+                                                    SolverMethod::automatic);
     const std::string ls      = prm.get("Linear solver");
     linear_solver             = (ls == "direct" ? LinearSolverType::direct :
                                  ls == "cg-amg" ? LinearSolverType::cg_amg :

@@ -2,10 +2,11 @@
 #include <cctype>
 #include <cmath>
 #include <deal.II/base/function_parser.h>
+#include <deal.II/base/mu_parser_internal.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/grid/manifold.h>
-#include <iostream>
 #include <membranes/problem_data.h>
+#include <muParser.h>
 #include <sstream>
 #include <tuple>
 
@@ -70,6 +71,174 @@ namespace membranes
       text << ")";
       return text.str();
     }
+
+
+
+    /** The names of the variables: x, y. */
+    template <int dim>
+    std::vector<std::string>
+    variable_names()
+    {
+      return Utilities::split_string_list(
+        FunctionParser<dim>::default_variable_names());
+    }
+
+
+
+    /**
+     * Set up @p parser for @p expression as deal.II 9.4's FunctionParser
+     * sets up its own muparser objects (internal::FunctionParser::
+     * ParserImplementation::init_muparser()), so that an expression means
+     * the same and gives the same values, to the last bit: the
+     * @p constants, the variables x, y bound to the coordinates of
+     * @p point, deal.II's functions if, int, ceil, floor, cot, csc, sec,
+     * log, pow, erfc, rand, rand_seed and operators |, & (deal.II's own
+     * definitions, with the same permission to fold constants), and the
+     * blanks between a function name and its parenthesis removed.
+     */
+    template <int dim>
+    void
+    set_up(mu::Parser                          &parser,
+           const std::string                   &expression,
+           const std::map<std::string, double> &constants,
+           Point<dim>                          &point)
+    {
+      namespace deal_ii = dealii::internal::FunctionParser;
+      for (const auto &[name, value] : constants)
+        parser.DefineConst(name, value);
+      const auto names = variable_names<dim>();
+      for (unsigned int d = 0; d < dim; ++d)
+        parser.DefineVar(names[d], &point[d]);
+      parser.DefineFun("if", deal_ii::mu_if, true);
+      parser.DefineOprt("|", deal_ii::mu_or, 1);
+      parser.DefineOprt("&", deal_ii::mu_and, 2);
+      parser.DefineFun("int", deal_ii::mu_int, true);
+      parser.DefineFun("ceil", deal_ii::mu_ceil, true);
+      parser.DefineFun("cot", deal_ii::mu_cot, true);
+      parser.DefineFun("csc", deal_ii::mu_csc, true);
+      parser.DefineFun("floor", deal_ii::mu_floor, true);
+      parser.DefineFun("sec", deal_ii::mu_sec, true);
+      parser.DefineFun("log", deal_ii::mu_log, true);
+      parser.DefineFun("pow", deal_ii::mu_pow, true);
+      parser.DefineFun("erfc", deal_ii::mu_erfc, true);
+      parser.DefineFun("rand_seed", deal_ii::mu_rand_seed, true);
+      parser.DefineFun("rand", deal_ii::mu_rand, true);
+
+      std::string text = expression;
+      for (const std::string &name : deal_ii::get_function_names())
+        for (auto at = text.find(name); at != std::string::npos;
+             at      = text.find(name, at + name.size()))
+          while (
+            at + name.size() < text.size() &&
+            (text[at + name.size()] == ' ' || text[at + name.size()] == '\t'))
+            text.erase(at + name.size(), 1);
+      parser.SetExpr(text);
+    }
+
+
+
+    /**
+     * The expressions of one entry of the scene, separated by ';' (one for
+     * a function, dim for a gradient, as deal.II's FunctionParser reads a
+     * function with that many components), each in a muparser object set up
+     * by set_up(), their variables bound to the coordinates of one point.
+     */
+    template <int dim>
+    class ParsedEntry
+    {
+    public:
+      /**
+       * Parse @p text, the value of entry @p entry, as @p n_components
+       * expressions with @p constants and the variables bound to @p point.
+       * Each is evaluated once at the origin, so that a syntax error or an
+       * unknown name surfaces here, as an InputError naming the entry,
+       * rather than mid-run; its value there is not checked (the origin
+       * need not be in the domain: the L-shape's loads are singular at its
+       * corner).
+       */
+      ParsedEntry(const std::string                   &entry,
+                  const std::string                   &text,
+                  const unsigned int                   n_components,
+                  const std::map<std::string, double> &constants,
+                  Point<dim>                          &point)
+        : entry(entry)
+        , text(text)
+      {
+        const auto expressions = Utilities::split_string_list(text, ';');
+        if (expressions.size() != n_components)
+          throw invalid("expected " + std::to_string(n_components) +
+                        (n_components == 1 ?
+                           " expression in x, y" :
+                           " expressions in x, y separated by ';', "
+                           "the derivatives by x and by y") +
+                        ", found " + std::to_string(expressions.size()));
+        for (unsigned int c = 0; c < n_components; ++c)
+          try
+            {
+              parsers.push_back(std::make_unique<mu::Parser>());
+              set_up(*parsers.back(), expressions[c], constants, point);
+              point = Point<dim>();
+              parsers.back()->Eval();
+            }
+          catch (const mu::ParserError &e)
+            {
+              throw invalid(
+                "not a valid expression in x, y (" +
+                (n_components == 1 ? "" : "'" + expressions[c] + "': ") +
+                e.GetMsg() + ")");
+            }
+      }
+
+      /**
+       * Expression @p c at the point that the variables are bound to: one
+       * run of muparser's bytecode, with no lock and no lookup (unlike
+       * FunctionParser::value(), which finds its parser in thread-local
+       * storage on every call; this program evaluates from one thread per
+       * process).
+       */
+      double
+      evaluate(const unsigned int c) const
+      {
+        return parsers[c]->Eval();
+      }
+
+      /** The InputError for this entry, which should be @p allowed. */
+      Parameters::InputError
+      invalid(const std::string &allowed) const
+      {
+        return Parameters::invalid_entry(entry, text, allowed);
+      }
+
+      /**
+       * Throw the InputError for @p what at @p p if @p value is not finite
+       * or larger than max_magnitude in magnitude.
+       */
+      void
+      check(const double value, const Point<dim> &p, const char *what) const
+      {
+        if (!(std::abs(value) <= Parameters::max_magnitude))
+          throw out_of_range(value, p, what);
+      }
+
+    private:
+      /** The InputError of check(), kept out of its fast path. */
+      Parameters::InputError
+      out_of_range(const double      value,
+                   const Point<dim> &p,
+                   const char       *what) const
+      {
+        std::ostringstream allowed;
+        allowed << "its " << what << " at " << at(p) << " is " << value
+                << "; an expression must be finite and at most "
+                << Parameters::max_magnitude
+                << " in magnitude wherever it is evaluated";
+        return invalid(allowed.str());
+      }
+
+      const std::string                        entry;
+      const std::string                        text;
+      std::vector<std::unique_ptr<mu::Parser>> parsers;
+    };
   } // namespace
 
 
@@ -83,65 +252,73 @@ namespace membranes
    * its gradient in the error norms), on every mesh, so that a NaN or an
    * infinity never enters a computation unnoticed, wherever the expression
    * produces it.
+   *
+   * The gradient is given by a second entry when the scene has one (the
+   * exact gradients of the displacements); otherwise it is the central
+   * difference of the expression with the step of set_gradient_step().
    */
   template <int dim>
   class ProblemData<dim>::Expression : public Function<dim>
   {
   public:
     /**
-     * Parse @p expression, the value of entry @p entry. It is evaluated
-     * once at the origin so that a syntax error or an unknown name surfaces
-     * here, as an InputError naming the entry, rather than mid-run; its
-     * value there is not checked (the origin need not be in the domain:
-     * the L-shape's loads are singular at its corner).
+     * The expression @p expression of entry @p entry, and, if
+     * @p gradient_expression is not empty, its gradient from entry
+     * @p gradient_entry.
      */
     Expression(const std::string                   &entry,
                const std::string                   &expression,
-               const std::map<std::string, double> &constants)
-      : entry(entry)
-      , expression(expression)
-      , parser(1, 0.0, 1e-5) // a step for gradient(), see set_gradient_step()
+               const std::map<std::string, double> &constants,
+               const std::string                   &gradient_entry      = "",
+               const std::string                   &gradient_expression = "")
+      : function(entry, expression, 1, constants, point)
     {
-      parser.set_formula(AutoDerivativeFunction<dim>::Euler);
-      // The parser reports syntax errors on std::cerr before it throws:
-      // keep that text out of the program's one-line message.
-      struct SilenceCerr
-      {
-        std::ostringstream sink;
-        std::streambuf    *original = std::cerr.rdbuf(sink.rdbuf());
-        ~SilenceCerr()
-        {
-          std::cerr.rdbuf(original);
-        }
-      } silence;
-      try
-        {
-          parser.initialize(FunctionParser<dim>::default_variable_names(),
-                            expression,
-                            constants);
-          parser.value(Point<dim>());
-        }
-      catch (const ExceptionBase &e)
-        {
-          throw invalid("not a valid expression in x, y (" +
-                        Parameters::one_line_message(e) + ")");
-        }
+      if (!Utilities::trim(gradient_expression).empty())
+        exact_gradient = std::make_unique<ParsedEntry<dim>>(
+          gradient_entry, gradient_expression, dim, constants, point);
     }
+
+    /** The parsers hold the address of #point. */
+    Expression(const Expression &) = delete;
 
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
-      const double result = parser.value(p);
-      check(result, p, "value");
+      point               = p;
+      const double result = function.evaluate(0);
+      function.check(result, p, "value");
       return result;
     }
 
     Tensor<1, dim>
     gradient(const Point<dim> &p, const unsigned int = 0) const override
     {
-      const Tensor<1, dim> gradient = parser.gradient(p);
+      Tensor<1, dim> gradient;
+      if (exact_gradient)
+        {
+          point = p;
+          for (unsigned int d = 0; d < dim; ++d)
+            gradient[d] = exact_gradient->evaluate(d);
+          static const char *const derivatives[] = {"derivative by x",
+                                                    "derivative by y",
+                                                    "derivative by z"};
+          for (unsigned int d = 0; d < dim; ++d)
+            exact_gradient->check(gradient[d], p, derivatives[d]);
+          return gradient;
+        }
+      // The central differences of deal.II's AutoDerivativeFunction
+      // (formula Euler), in the same arithmetic.
       for (unsigned int d = 0; d < dim; ++d)
-        check(gradient[d], p, "gradient (by finite differences)");
+        {
+          Tensor<1, dim> step;
+          step[d]              = step_size;
+          point                = p + step;
+          const double forward = function.evaluate(0);
+          point                = p - step;
+          gradient[d] = (forward - function.evaluate(0)) / (2 * step_size);
+        }
+      for (unsigned int d = 0; d < dim; ++d)
+        function.check(gradient[d], p, "gradient (by finite differences)");
       return gradient;
     }
 
@@ -149,36 +326,23 @@ namespace membranes
     void
     set_gradient_step(const double step)
     {
-      parser.set_h(step);
+      step_size = step;
     }
 
     /** The InputError for this entry, which should be @p allowed. */
     Parameters::InputError
     invalid(const std::string &allowed) const
     {
-      return Parameters::invalid_entry(entry, expression, allowed);
+      return function.invalid(allowed);
     }
 
   private:
-    void
-    check(const double       value,
-          const Point<dim>  &p,
-          const std::string &what) const
-    {
-      if (!(std::abs(value) <= Parameters::max_magnitude))
-        {
-          std::ostringstream allowed;
-          allowed << "its " << what << " at " << at(p) << " is " << value
-                  << "; an expression must be finite and at most "
-                  << Parameters::max_magnitude
-                  << " in magnitude wherever it is evaluated";
-          throw invalid(allowed.str());
-        }
-    }
+    /** The variables x, y of every expression. */
+    mutable Point<dim> point;
 
-    const std::string   entry;
-    const std::string   expression;
-    FunctionParser<dim> parser;
+    ParsedEntry<dim>                  function;
+    std::unique_ptr<ParsedEntry<dim>> exact_gradient;
+    double                            step_size = 1e-5;
   };
 
 
@@ -223,10 +387,14 @@ namespace membranes
       {
         exact_u[0]   = std::make_unique<Expression>("Exact solution/u1",
                                                   exact.u1,
-                                                  constants);
+                                                  constants,
+                                                  "Exact solution/u1 gradient",
+                                                  exact.u1_gradient);
         exact_u[1]   = std::make_unique<Expression>("Exact solution/u2",
                                                   exact.u2,
-                                                  constants);
+                                                  constants,
+                                                  "Exact solution/u2 gradient",
+                                                  exact.u2_gradient);
         exact_action = std::make_unique<Expression>("Exact solution/lambda",
                                                     exact.lambda,
                                                     constants);

@@ -41,6 +41,9 @@ CASES = [
     ("exact solution that does not parse",
      "subsection Exact solution\n  set Known = true\n  set lambda = )\nend\n",
      [], ["Exact solution/lambda"]),
+    ("exact gradient with one expression",
+     "subsection Exact solution\n  set Known = true\n"
+     "  set u1 gradient = 2*x\nend\n", [], ["Exact solution/u1 gradient"]),
     ("bad function constants",
      "subsection Problem\n  set Function constants = R:0.5\nend\n", [],
      ["Problem/Function constants"]),
@@ -129,8 +132,9 @@ def check_good_command_lines(membranes):
     printed = run([membranes, "--print-parameters"])
     names = ["Domain", "Mesh file", "Cell type", "Initial refinement", "mu1",
              "mu2", "Function constants", "f1", "f2", "g", "g2", "Known",
-             "lambda", "Method", "Linear solver", "Tolerance",
-             "Max active set iterations", "Strategy", "Cycles", "Marking",
+             "lambda", "u1 gradient", "u2 gradient", "Method",
+             "Linear solver", "Tolerance", "Max active set iterations",
+             "Strategy", "Cycles", "Marking",
              "Bulk parameter", "Coarsen fraction", "Max dofs", "Estimator", "Directory", "Report",
              "Write vtu", "Write nodal values", "Flux reconstruction"]
     missing = [n for n in names if "set %s " % n not in printed.stdout]

@@ -414,6 +414,12 @@ MORE_EXPRESSIONS = [
     # NaN in a strip between the vertices of the mesh.
     ("Problem/f1", "(x > 0.1 && x < 0.2) ? sqrt(-1) : 0"),
     ("Exact solution/u2", "(x > 0.1 && x < 0.2) ? sqrt(-1) : 0"),
+    # Exact gradients: two expressions separated by ';', each checked.
+    ("Exact solution/u1 gradient", "2*x"),
+    ("Exact solution/u1 gradient", "x; y; 0"),
+    ("Exact solution/u2 gradient", "x; y^"),
+    ("Exact solution/u1 gradient", "0/0; 0"),
+    ("Exact solution/u2 gradient", "0; log(x)"),
 ]
 
 # (what, geometry, problem entries, the entry to name): singular data on a

@@ -138,6 +138,12 @@ namespace membranes::Parameters
     std::string u1;     ///< Exact u1(x, y).
     std::string u2;     ///< Exact u2(x, y).
     std::string lambda; ///< Exact action λ(x, y).
+    /**
+     * ∇u1 as `∂/∂x; ∂/∂y`, two expressions separated by ';'; empty: central
+     * finite differences of u1.
+     */
+    std::string u1_gradient;
+    std::string u2_gradient; ///< ∇u2, likewise.
 
     static void
     declare_parameters(ParameterHandler &prm);
@@ -147,6 +153,7 @@ namespace membranes::Parameters
 
   enum class SolverMethod
   {
+    automatic,
     coupled,
     decoupled
   };
@@ -161,7 +168,8 @@ namespace membranes::Parameters
   /** Subsection `Solver`: the primal-dual active set method (SPEC §2.2). */
   struct Solver
   {
-    SolverMethod method; ///< Coupled (u1, u2) system or decoupled (s, w).
+    /** Coupled (u1, u2), decoupled (s, w), or the faster of the two. */
+    SolverMethod method;
     LinearSolverType
                  linear_solver; ///< UMFPACK, CG with AMG, or chosen by size.
     double       tolerance;     ///< Relative KKT residual to reach.

@@ -16,16 +16,22 @@ namespace membranes
    * heights g (membrane 1) and g2 (membrane 2, 0 in the paper), and, when
    * known, the exact solution (u1, u2, λ).
    *
-   * Every function is a deal.II FunctionParser expression in x, y with the
-   * scene's `Function constants` and the names `mu1`, `mu2`, `pi`, so that a
-   * manufactured solution written in terms of the tensions stays exact for
-   * any μ1, μ2. Expressions are parsed and evaluated once on construction;
-   * one that does not parse is an InputError naming its entry. Every value
-   * is checked where the program evaluates it: one that is not finite, or
-   * larger than Parameters::max_magnitude in magnitude, is an InputError
-   * naming the entry and the point. Gradients of
-   * the exact solution (for H1 errors) come from central (second-order)
-   * finite differences, with a step set by set_gradient_step().
+   * Every function is an expression in x, y in the syntax of deal.II's
+   * FunctionParser, with the scene's `Function constants` and the names
+   * `mu1`, `mu2`, `pi`, so that a manufactured solution written in terms of
+   * the tensions stays exact for any μ1, μ2. The expressions are evaluated
+   * by muparser directly, set up as FunctionParser sets it up (the same
+   * values to the last bit), without FunctionParser's lookup of a parser
+   * per thread on every evaluation. Expressions are parsed and evaluated
+   * once on construction; one that does not parse is an InputError naming
+   * its entry. Every value is checked where the program evaluates it: one
+   * that is not finite, or larger than Parameters::max_magnitude in
+   * magnitude, is an InputError naming the entry and the point.
+   *
+   * The gradients of the exact displacements (for the H1 errors) are the
+   * scene's `Exact solution/u1 gradient` and `u2 gradient` when given (two
+   * expressions `∂/∂x; ∂/∂y`), otherwise central (second-order) finite
+   * differences of u1 and u2, with a step set by set_gradient_step().
    */
   template <int dim>
   class ProblemData
@@ -63,15 +69,19 @@ namespace membranes
 
     /**
      * Set the step of the finite differences that give the gradients of the
-     * exact displacements. The error norms set it relative to the cell they
-     * integrate over, so that the difference stencil never leaves the
-     * neighbourhood of the cell, however fine the mesh (near a re-entrant
-     * corner, a fixed step would reach across the corner).
+     * exact displacements (those without a gradient entry in the scene).
+     * The error norms set it relative to the cell they integrate over, so
+     * that the difference stencil never leaves the neighbourhood of the
+     * cell, however fine the mesh (near a re-entrant corner, a fixed step
+     * would reach across the corner).
      */
     void
     set_gradient_step(const double step) const;
 
-    /** Exact displacement u_i (i = 0 or 1); only when known. */
+    /**
+     * Exact displacement u_i (i = 0 or 1), with its gradient; only when
+     * known.
+     */
     const Function<dim> &
     exact_displacement(const unsigned int i) const;
 
