@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
-#include <deal.II/base/timer.h>
 #include <iomanip>
 #include <limits>
 #include <membranes/active_set_solver.h>
@@ -23,23 +22,26 @@ namespace membranes
 
 
 
-    /** The linear problem of one iteration, as `Solver/Method` asks. */
+    /**
+     * The linear problem of one iteration, as `Solver/Method` asks; `auto`
+     * is the decoupled one, faster on every scene measured
+     * (benchmarks/solver_cost.sh): its systems are half the size of the
+     * coupled one, S is solved once per mesh, and its operator is assembled
+     * once per mesh.
+     */
     template <int dim>
     std::unique_ptr<ActiveSetSystem<dim>>
     make_active_set_system(const Parameters::Solver  &parameters,
                            const Discretization<dim> &discretization,
                            const ProblemData<dim>    &data,
+                           TimerOutput               &timer,
                            const MPI_Comm             mpi_communicator)
     {
-      if (parameters.method == Parameters::SolverMethod::decoupled)
-        return std::make_unique<DecoupledSystem<dim>>(parameters,
-                                                      discretization,
-                                                      data,
-                                                      mpi_communicator);
-      return std::make_unique<CoupledSystem<dim>>(parameters,
-                                                  discretization,
-                                                  data,
-                                                  mpi_communicator);
+      if (parameters.method == Parameters::SolverMethod::coupled)
+        return std::make_unique<CoupledSystem<dim>>(
+          parameters, discretization, data, timer, mpi_communicator);
+      return std::make_unique<DecoupledSystem<dim>>(
+        parameters, discretization, data, timer, mpi_communicator);
     }
 
     /** @p set with the status of the vertices @p dofs changed. */
@@ -172,14 +174,17 @@ namespace membranes
     const Discretization<dim> &discretization,
     const ProblemData<dim>    &data,
     const ConditionalOStream  &pcout,
+    TimerOutput               &timer,
     const MPI_Comm             mpi_communicator)
     : parameters(parameters)
     , data(data)
     , pcout(pcout)
+    , timer(timer)
     , mpi_communicator(mpi_communicator)
     , system(make_active_set_system(parameters,
                                     discretization,
                                     data,
+                                    timer,
                                     mpi_communicator))
     , history(mpi_communicator)
   {}
@@ -254,6 +259,79 @@ namespace membranes
           changes.push_back({a.dof[0], violation / epsilon});
       }
     return changes;
+  }
+
+
+
+  template <int dim>
+  std::vector<StatusChange>
+  ActiveSetSolver<dim>::predicted_changes(DiscreteAction<dim> &action,
+                                          const VectorType    &solution,
+                                          const IndexSet      &active_set) const
+  {
+    const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
+    const double epsilon = parameters.tolerance;
+    const double u_scale =
+      std::max(solution.linfty_norm(), std::numeric_limits<double>::min());
+    const auto &vertices = action.vertices();
+
+    // Projected l1-Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
+    // max(0, W_a − r_a / (μ̄ ‖A_a‖₁)), r_a = λ_a d_a the force of the
+    // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
+    // condensed Laplacian; U1 moves by μ2/M and U2 by −μ1/M of the step.
+    VectorType iterate = solution;
+    for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
+      {
+        action.compute(iterate);
+        for (unsigned int k = 0; k < vertices.size(); ++k)
+          {
+            const auto  &a = vertices[k];
+            const double w = iterate[a.dof[0]] - iterate[a.dof[1]];
+            const double r = contact_lambda(action, k) * a.dual_cell_measure;
+            const double step =
+              std::max(0., w - r / (data.mu_bar * a.stiffness_row_l1_norm)) - w;
+            iterate[a.dof[0]] += mu2 / M * step;
+            iterate[a.dof[1]] -= mu1 / M * step;
+          }
+        iterate.compress(VectorOperation::insert);
+      }
+    action.compute(iterate);
+
+    // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
+    // indifference.
+    std::vector<StatusChange> changes;
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        const auto  &a = vertices[k];
+        const double c =
+          data.mu_bar * a.stiffness_diagonal / a.dual_cell_measure;
+        const double test = (contact_lambda(action, k) -
+                             c * (iterate[a.dof[0]] - iterate[a.dof[1]])) /
+                            (c * u_scale);
+        const double violation = active_set.is_element(a.dof[0]) ? -test : test;
+        if (violation > epsilon)
+          changes.push_back({a.dof[0], violation / epsilon});
+      }
+    return changes;
+  }
+
+
+
+  template <int dim>
+  std::vector<StatusChange>
+  ActiveSetSolver<dim>::next_changes(
+    DiscreteAction<dim>             &action,
+    const VectorType                &solution,
+    const IndexSet                  &active_set,
+    const std::vector<StatusChange> &changes) const
+  {
+    if (history.cycles() > 0)
+      return changes;
+    std::vector<StatusChange> predicted =
+      predicted_changes(action, solution, active_set);
+    if (Utilities::MPI::sum(predicted.size(), mpi_communicator) == 0)
+      return changes;
+    return predicted;
   }
 
 
@@ -358,12 +436,14 @@ namespace membranes
                               IndexSet            &active_set)
   {
     Statistics statistics;
-    Timer      timer;
     VectorType ghosted_solution(locally_owned_dofs,
                                 locally_relevant_dofs,
                                 mpi_communicator);
-    ghosted_solution = solution;
-    action.compute(ghosted_solution);
+    {
+      TimerOutput::Scope scope(timer, "solve");
+      ghosted_solution = solution;
+      action.compute(solution);
+    }
 
     // The forces of the last iterate set the scale of the linear solver's
     // residual: a hundredth of what the KKT test allows.
@@ -384,9 +464,9 @@ namespace membranes
                       linear_tolerance(),
                       statistics);
 
-        timer.restart();
+        TimerOutput::Scope scope(timer, "solve");
         ghosted_solution = solution;
-        action.compute(ghosted_solution);
+        action.compute(solution);
         const std::vector<StatusChange> changes =
           wanted_changes(action, ghosted_solution, active_set);
         const auto n_changes =
@@ -395,7 +475,6 @@ namespace membranes
         statistics.kkt_residual =
           kkt_residual(action, ghosted_solution, active_set);
         statistics.iterations = iteration;
-        statistics.solve_time += timer.wall_time();
 
         pcout << "      active set iteration " << iteration << ": "
               << Utilities::MPI::sum(active_set.n_elements(), mpi_communicator)
@@ -430,7 +509,9 @@ namespace membranes
 
         if (n_changes > 0)
           {
-            const auto step = history.next(active_set, changes);
+            const auto step =
+              history.next(active_set,
+                           next_changes(action, solution, active_set, changes));
             if (step.cycle_to)
               pcout << "      cycle: iteration " << iteration + 1
                     << " would repeat the active set of iteration "

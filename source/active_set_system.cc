@@ -14,9 +14,11 @@ namespace membranes
     const Parameters::Solver  &parameters,
     const Discretization<dim> &discretization,
     const ProblemData<dim>    &data,
+    TimerOutput               &timer,
     const MPI_Comm             mpi_communicator)
     : discretization(discretization)
     , data(data)
+    , timer(timer)
     , mpi_communicator(mpi_communicator)
     , method(method)
     , linear_solver(parameters.linear_solver, mpi_communicator)
@@ -35,11 +37,15 @@ namespace membranes
 
   template <int dim>
   void
-  ActiveSetSystem<dim>::add_boundary_values(
+  ActiveSetSystem<dim>::make_mesh_constraints(
     const DoFHandler<dim>     &dof_handler,
     const Function<dim>       &boundary_values,
+    const IndexSet            &locally_relevant_dofs,
     AffineConstraints<double> &constraints) const
   {
+    constraints.clear();
+    constraints.reinit(locally_relevant_dofs);
+    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
     std::map<types::boundary_id, const Function<dim> *> boundary_functions;
     for (const auto id : dof_handler.get_triangulation().get_boundary_ids())
       boundary_functions[id] = &boundary_values;
@@ -47,6 +53,7 @@ namespace membranes
                                              dof_handler,
                                              boundary_functions,
                                              constraints);
+    constraints.close();
   }
 
 
@@ -78,16 +85,27 @@ namespace membranes
   template <int dim>
   void
   ActiveSetSystem<dim>::solve_linear_system(
-    const AffineConstraints<double> &constraints,
-    VectorType                      &x,
-    const double                     tolerance,
-    ActiveSetStatistics             &statistics)
+    const TrilinosWrappers::SparseMatrix &matrix,
+    const VectorType                     &rhs,
+    const AffineConstraints<double>      &constraints,
+    VectorType                           &x,
+    const double                          tolerance,
+    ActiveSetStatistics                  &statistics,
+    const TrilinosWrappers::SparseMatrix *mesh_matrix)
   {
-    Timer timer;
+    TimerOutput::Scope scope(timer, "solve");
     statistics.linear_iterations +=
-      linear_solver.solve(system_matrix, x, system_rhs, tolerance);
+      linear_solver.solve(matrix, x, rhs, tolerance, mesh_matrix);
     constraints.distribute(x);
-    statistics.solve_time += timer.wall_time();
+  }
+
+
+
+  template <int dim>
+  bool
+  ActiveSetSystem<dim>::has_mesh_preconditioner() const
+  {
+    return linear_solver.has_mesh_preconditioner();
   }
 
 

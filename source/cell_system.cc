@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <membranes/cell_system.h>
 
 namespace membranes
@@ -41,18 +42,35 @@ namespace membranes
   CellSystem<dim>::reinit(
     const typename DoFHandler<dim>::active_cell_iterator &cell)
   {
+    reinit_operator(cell);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        data.load(i).value_list(fe_values.get_quadrature_points(),
+                                load_values[i]);
+        loads[i] = 0;
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          for (const unsigned int v : fe_values.dof_indices())
+            loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
+                           fe_values.JxW(q);
+      }
+    for (unsigned int j = 0; j < dof_indices.size(); ++j)
+      rhs(j) = loads[membrane[j]](scalar_index[j]);
+  }
+
+
+
+  template <int dim>
+  void
+  CellSystem<dim>::reinit_operator(
+    const typename DoFHandler<dim>::active_cell_iterator &cell)
+  {
     // The FEValues object belongs to the scalar element, not to the
     // DoFHandler's FESystem: it sees the cell only as a cell of the mesh.
     fe_values.reinit(typename Triangulation<dim>::cell_iterator(cell));
     cell->get_dof_indices(dof_indices);
-    for (unsigned int i = 0; i < 2; ++i)
-      data.load(i).value_list(fe_values.get_quadrature_points(),
-                              load_values[i]);
 
     laplace_matrix     = 0;
     scalar_lumped_mass = 0;
-    for (auto &load : loads)
-      load = 0;
     for (const unsigned int q : fe_values.quadrature_point_indices())
       for (const unsigned int v : fe_values.dof_indices())
         {
@@ -60,9 +78,6 @@ namespace membranes
             laplace_matrix(v, w) += fe_values.shape_grad(v, q) *
                                     fe_values.shape_grad(w, q) *
                                     fe_values.JxW(q);
-          for (unsigned int i = 0; i < 2; ++i)
-            loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
-                           fe_values.JxW(q);
           scalar_lumped_mass(v) +=
             fe_values.shape_value(v, q) * fe_values.JxW(q);
         }
@@ -77,9 +92,31 @@ namespace membranes
             (membrane[k] == c ?
                data.mu[c] * laplace_matrix(scalar_index[j], scalar_index[k]) :
                0.);
-        rhs(j)         = loads[c](scalar_index[j]);
         lumped_mass(j) = scalar_lumped_mass(scalar_index[j]);
       }
+  }
+
+
+
+  template <int dim>
+  void
+  CellSystem<dim>::set_loads(const double *cell_loads)
+  {
+    for (auto &load : loads)
+      for (unsigned int v = 0; v < load.size(); ++v)
+        load(v) = *cell_loads++;
+    for (unsigned int j = 0; j < dof_indices.size(); ++j)
+      rhs(j) = loads[membrane[j]](scalar_index[j]);
+  }
+
+
+
+  template <int dim>
+  void
+  CellSystem<dim>::copy_loads(double *cell_loads) const
+  {
+    for (const auto &load : loads)
+      cell_loads = std::copy(load.begin(), load.end(), cell_loads);
   }
 
 

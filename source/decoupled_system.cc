@@ -1,7 +1,6 @@
-#include <deal.II/base/timer.h>
+#include <Epetra_CrsMatrix.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <membranes/decoupled_system.h>
-#include <tuple>
 
 namespace membranes
 {
@@ -34,6 +33,52 @@ namespace membranes
               cell->index(),
               &dof_handler};
     }
+
+
+
+    /**
+     * @p matrix = @p coefficient · @p base with the off-diagonal entries of
+     * the rows and columns of @p eliminated (locally relevant DoFs) set to
+     * zero: the condensation of the homogeneous constraints x_k = 0, k in
+     * @p eliminated, on the locally owned rows of a matrix with the
+     * sparsity pattern of @p base, in one pass over its entries.
+     */
+    void
+    eliminate_rows_and_columns(const TrilinosWrappers::SparseMatrix &base,
+                               const double                    coefficient,
+                               const IndexSet                 &eliminated,
+                               TrilinosWrappers::SparseMatrix &matrix)
+    {
+      const Epetra_CrsMatrix &from = base.trilinos_matrix();
+      const Epetra_CrsMatrix &to   = matrix.trilinos_matrix();
+      std::vector<bool>       eliminated_column(from.NumMyCols());
+      for (int c = 0; c < from.NumMyCols(); ++c)
+        eliminated_column[c] = eliminated.is_element(from.GCID64(c));
+      for (int row = 0; row < from.NumMyRows(); ++row)
+        {
+          int     n_entries, n_target_entries;
+          double *values, *target_values;
+          int    *columns, *target_columns;
+          from.ExtractMyRowView(row, n_entries, values, columns);
+          to.ExtractMyRowView(row,
+                              n_target_entries,
+                              target_values,
+                              target_columns);
+          AssertDimension(n_entries, n_target_entries);
+          const auto global_row     = from.GRID64(row);
+          const bool eliminated_row = eliminated.is_element(global_row);
+          for (int k = 0; k < n_entries; ++k)
+            {
+              Assert(columns[k] == target_columns[k], ExcInternalError());
+              const bool off_diagonal = (from.GCID64(columns[k]) != global_row);
+              target_values[k] =
+                (off_diagonal &&
+                 (eliminated_row || eliminated_column[columns[k]])) ?
+                  0. :
+                  coefficient * values[k];
+            }
+        }
+    }
   } // namespace
 
 
@@ -43,14 +88,17 @@ namespace membranes
     const Parameters::Solver  &parameters,
     const Discretization<dim> &discretization,
     const ProblemData<dim>    &data,
+    TimerOutput               &timer,
     const MPI_Comm             mpi_communicator)
     : ActiveSetSystem<dim>("decoupled",
                            parameters,
                            discretization,
                            data,
+                           timer,
                            mpi_communicator)
     , sum_boundary_values(combine_boundary_values(data, data.mu[0], data.mu[1]))
     , difference_boundary_values(combine_boundary_values(data, 1., -1.))
+    , action(nullptr)
   {}
 
 
@@ -59,10 +107,11 @@ namespace membranes
   void
   DecoupledSystem<dim>::setup(const DoFHandler<dim> &dof_handler,
                               const IndexSet &,
-                              const IndexSet &locally_relevant_dofs,
-                              const DiscreteAction<dim> &)
+                              const IndexSet            &locally_relevant_dofs,
+                              const DiscreteAction<dim> &action)
   {
     this->dof_handler           = &dof_handler;
+    this->action                = &action;
     this->locally_relevant_dofs = locally_relevant_dofs;
     scalar_dof_handler.reinit(dof_handler.get_triangulation());
     scalar_dof_handler.distribute_dofs(
@@ -98,16 +147,27 @@ namespace membranes
               }
         }
 
-    // W = 0 on active vertices has no entries: the pattern of S, with
-    // the hanging node and boundary constraints, holds the matrix of W for
-    // every active set.
-    make_constraints(*sum_boundary_values,
-                     IndexSet(dof_handler.n_dofs()),
-                     sum_constraints);
+    // Both scalar problems have the hanging node constraints and boundary
+    // values on ∂ω, those of S and those of W: the same lines, hence one
+    // condensed operator A for both. W = 0 on active vertices only removes
+    // couplings, so the pattern of A holds the matrix of W for every active
+    // set.
+    this->make_mesh_constraints(scalar_dof_handler,
+                                *sum_boundary_values,
+                                locally_relevant_scalar_dofs,
+                                sum_constraints);
+    this->make_mesh_constraints(scalar_dof_handler,
+                                *difference_boundary_values,
+                                locally_relevant_scalar_dofs,
+                                difference_constraints);
     this->reinit_linear_system(scalar_dof_handler,
                                sum_constraints,
                                locally_owned_scalar_dofs,
                                locally_relevant_scalar_dofs);
+    laplace_matrix.reinit(this->system_matrix);
+    preconditioner_matrix.reinit(this->system_matrix);
+    sum_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
+    difference_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     sum.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     difference.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
   }
@@ -116,47 +176,47 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::make_constraints(
-    const Function<dim>       &boundary_values,
-    const IndexSet            &active_set,
-    AffineConstraints<double> &constraints) const
+  DecoupledSystem<dim>::assemble_operator()
   {
-    constraints.clear();
-    constraints.reinit(locally_relevant_scalar_dofs);
-    DoFTools::make_hanging_node_constraints(scalar_dof_handler, constraints);
-
-    for (const auto dof : active_set)
-      constraints.add_line(
-        scalar_dof[locally_relevant_dofs.index_within_set(dof)]);
-
-    this->add_boundary_values(scalar_dof_handler, boundary_values, constraints);
-    constraints.close();
-  }
-
-
-
-  template <int dim>
-  void
-  DecoupledSystem<dim>::assemble_scalar_system(
-    const AffineConstraints<double> &constraints,
-    const double                     coefficient,
-    const std::array<double, 2>     &load_weights)
-  {
+    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double       M = mu1 + mu2;
     const unsigned int n =
       this->discretization.fe->base_element(0).n_dofs_per_cell();
-    FullMatrix<double>                   cell_matrix(n, n);
-    Vector<double>                       cell_rhs(n);
+    FullMatrix<double>                   difference_matrix(n, n);
+    Vector<double>                       sum_loads(n), difference_loads(n);
     std::vector<types::global_dof_index> scalar_dof_indices(n);
-    this->assemble_system(
-      *dof_handler,
-      constraints,
-      [&](const auto &cell, const CellSystem<dim> &cell_system) {
-        cell_matrix.equ(coefficient, cell_system.laplace_matrix);
-        cell_rhs.equ(load_weights[0], cell_system.loads[0]);
-        cell_rhs.add(load_weights[1], cell_system.loads[1]);
-        cell_of(scalar_dof_handler, cell)->get_dof_indices(scalar_dof_indices);
-        return std::tie(cell_matrix, cell_rhs, scalar_dof_indices);
-      });
+
+    laplace_matrix = 0;
+    sum_rhs        = 0;
+    difference_rhs = 0;
+    CellSystem<dim> cell_system(this->discretization, this->data);
+    for (const auto &cell : dof_handler->active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell_system.reinit_operator(cell);
+          cell_system.set_loads(action->cell_loads(cell));
+          cell_of(scalar_dof_handler, cell)
+            ->get_dof_indices(scalar_dof_indices);
+          sum_loads.equ(1., cell_system.loads[0]);
+          sum_loads.add(1., cell_system.loads[1]);
+          sum_constraints.distribute_local_to_global(cell_system.laplace_matrix,
+                                                     sum_loads,
+                                                     scalar_dof_indices,
+                                                     laplace_matrix,
+                                                     sum_rhs);
+          // The loads of W, with its boundary values lifted by the cell
+          // matrix of its system, μ̄ A_K.
+          difference_matrix.equ(this->data.mu_bar, cell_system.laplace_matrix);
+          difference_loads.equ(mu2 / M, cell_system.loads[0]);
+          difference_loads.add(-mu1 / M, cell_system.loads[1]);
+          difference_constraints.distribute_local_to_global(difference_loads,
+                                                            scalar_dof_indices,
+                                                            difference_rhs,
+                                                            difference_matrix);
+        }
+    laplace_matrix.compress(VectorOperation::add);
+    sum_rhs.compress(VectorOperation::add);
+    difference_rhs.compress(VectorOperation::add);
   }
 
 
@@ -167,24 +227,26 @@ namespace membranes
                                 const double         tolerance,
                                 ActiveSetStatistics &statistics)
   {
-    Timer        timer;
-    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
-      {
-        const auto   k  = locally_owned_scalar_dofs.nth_index_in_set(j);
-        const double u1 = solution[membrane_dofs[j][0]];
-        const double u2 = solution[membrane_dofs[j][1]];
-        sum[k]          = mu1 * u1 + mu2 * u2;
-        difference[k]   = u1 - u2;
-      }
-    sum.compress(VectorOperation::insert);
-    difference.compress(VectorOperation::insert);
+    {
+      TimerOutput::Scope scope(this->timer, "assembly");
+      const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+      for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+        {
+          const auto   k  = locally_owned_scalar_dofs.nth_index_in_set(j);
+          const double u1 = solution[membrane_dofs[j][0]];
+          const double u2 = solution[membrane_dofs[j][1]];
+          sum[k]          = mu1 * u1 + mu2 * u2;
+          difference[k]   = u1 - u2;
+        }
+      sum.compress(VectorOperation::insert);
+      difference.compress(VectorOperation::insert);
 
-    sum_constraints.distribute(sum);
-    assemble_scalar_system(sum_constraints, 1., {{1., 1.}});
-    statistics.assembly_time += timer.wall_time();
+      sum_constraints.distribute(sum);
+      assemble_operator();
+    }
 
-    this->solve_linear_system(sum_constraints, sum, tolerance, statistics);
+    this->solve_linear_system(
+      laplace_matrix, sum_rhs, sum_constraints, sum, tolerance, statistics);
   }
 
 
@@ -197,24 +259,52 @@ namespace membranes
                               const double         tolerance,
                               ActiveSetStatistics &statistics)
   {
-    Timer        timer;
-    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double M = mu1 + mu2;
-    make_constraints(*difference_boundary_values,
-                     active_set,
-                     difference_constraints);
-    difference_constraints.distribute(difference);
-    assemble_scalar_system(difference_constraints,
-                           this->data.mu_bar,
-                           {{mu2 / M, -mu1 / M}});
-    statistics.assembly_time += timer.wall_time();
+    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double       M = mu1 + mu2;
+    TimerOutput::Scope assembly(this->timer, "assembly");
 
-    this->solve_linear_system(difference_constraints,
+    // The scalar DoFs of the active vertices; W = 0 there.
+    IndexSet active_scalar_dofs(scalar_dof_handler.n_dofs());
+    for (const auto dof : active_set)
+      active_scalar_dofs.add_index(
+        scalar_dof[locally_relevant_dofs.index_within_set(dof)]);
+    active_scalar_dofs.compress();
+    const IndexSet owned_active_scalar_dofs =
+      active_scalar_dofs & locally_owned_scalar_dofs;
+    const auto set_active_to_zero = [&](VectorType &vector) {
+      for (const auto k : owned_active_scalar_dofs)
+        vector[k] = 0;
+      vector.compress(VectorOperation::insert);
+    };
+
+    // The system of W: μ̄ A and the loads of the mesh, with the rows and
+    // columns of the active vertices eliminated (the constraints W_a = 0
+    // condensed, as AffineConstraints would do it in the assembly).
+    eliminate_rows_and_columns(laplace_matrix,
+                               this->data.mu_bar,
+                               active_scalar_dofs,
+                               this->system_matrix);
+    this->system_rhs = difference_rhs;
+    set_active_to_zero(this->system_rhs);
+    set_active_to_zero(difference);
+    difference_constraints.distribute(difference);
+    assembly.stop();
+
+    // The AMG hierarchy of the system of an earlier iteration on this mesh
+    // preconditions this one: the two differ near the free boundary only.
+    if (!this->has_mesh_preconditioner())
+      preconditioner_matrix.copy_from(this->system_matrix);
+    this->solve_linear_system(this->system_matrix,
+                              this->system_rhs,
+                              difference_constraints,
                               difference,
                               tolerance,
-                              statistics);
+                              statistics,
+                              &preconditioner_matrix);
 
-    timer.restart();
+    TimerOutput::Scope scope(this->timer, "solve");
+    set_active_to_zero(difference);
+    difference_constraints.distribute(difference);
     for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
       {
         const auto k = locally_owned_scalar_dofs.nth_index_in_set(j);
@@ -222,7 +312,6 @@ namespace membranes
         solution[membrane_dofs[j][1]] = (sum[k] - mu1 * difference[k]) / M;
       }
     solution.compress(VectorOperation::insert);
-    statistics.solve_time += timer.wall_time();
   }
 
 

@@ -1,7 +1,10 @@
+#include <Epetra_CrsMatrix.h>
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparsity_tools.h>
 #include <membranes/cell_system.h>
 #include <membranes/discrete_action.h>
 
@@ -12,6 +15,7 @@ namespace membranes
                                       const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
+    , loads_per_cell(0)
     , max_force(0)
     , l2_force(0)
   {}
@@ -24,41 +28,73 @@ namespace membranes
     const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints,
     const IndexSet                  &locally_owned_dofs,
+    const IndexSet                  &locally_relevant_dofs,
     const MPI_Comm                   mpi_communicator)
   {
-    this->dof_handler              = &dof_handler;
-    this->hanging_node_constraints = &hanging_node_constraints;
-    this->locally_owned_dofs       = locally_owned_dofs;
-    this->mpi_communicator         = mpi_communicator;
+    this->locally_owned_dofs = locally_owned_dofs;
+    this->mpi_communicator   = mpi_communicator;
 
     const FiniteElement<dim> &fe = *discretization.fe;
     const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
 
-    // d_a = ∫ φ_a as the row sums of the mass matrix, condensed with the
-    // hanging node constraints, and the diagonal ∫ |∇φ_a|².
+    // The operator of (4.5): μ_i times the Laplacian on each membrane, the
+    // membranes not coupled, condensed with the hanging node constraints
+    // (rows and columns of constrained DoFs moved to their parents).
+    Table<2, DoFTools::Coupling> coupling(fe.n_components(), fe.n_components());
+    for (unsigned int c = 0; c < fe.n_components(); ++c)
+      coupling(c, c) = DoFTools::always;
+    DynamicSparsityPattern dsp(locally_relevant_dofs);
+    DoFTools::make_sparsity_pattern(
+      dof_handler, coupling, dsp, hanging_node_constraints, false);
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               locally_owned_dofs,
+                                               mpi_communicator,
+                                               locally_relevant_dofs);
+    stiffness_matrix.reinit(locally_owned_dofs,
+                            locally_owned_dofs,
+                            dsp,
+                            mpi_communicator);
+    load_vector.reinit(locally_owned_dofs, mpi_communicator);
+
+    // The matrix and the loads ∫ f_i φ, d_a = ∫ φ_a as the row sums of the
+    // mass matrix, all condensed with the hanging node constraints, and the
+    // diagonal ∫ |∇φ_a|².
     VectorType dual_cell_measure(locally_owned_dofs, mpi_communicator);
     VectorType stiffness_diagonal(locally_owned_dofs, mpi_communicator);
 
     CellSystem<dim>    cell_system(discretization, data);
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     Vector<double>     local_stiffness(dofs_per_cell);
+    loads_per_cell = 2 * fe.base_element(0).n_dofs_per_cell();
+    loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
+                            loads_per_cell,
+                          0.);
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell_system.reinit(cell);
+          cell_system.copy_loads(
+            &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
           for (unsigned int i = 0; i < dofs_per_cell; ++i)
             {
               const unsigned int v = cell_system.scalar_index_of(i);
               local_stiffness(i)   = cell_system.laplace_matrix(v, v);
             }
           hanging_node_constraints.distribute_local_to_global(
+            cell_system.matrix, cell_system.dof_indices, stiffness_matrix);
+          hanging_node_constraints.distribute_local_to_global(
+            cell_system.rhs, cell_system.dof_indices, load_vector);
+          hanging_node_constraints.distribute_local_to_global(
             cell_system.lumped_mass,
             cell_system.dof_indices,
             dual_cell_measure);
           stiffness_diagonal.add(cell_system.dof_indices, local_stiffness);
         }
+    stiffness_matrix.compress(VectorOperation::add);
+    load_vector.compress(VectorOperation::add);
     dual_cell_measure.compress(VectorOperation::add);
     stiffness_diagonal.compress(VectorOperation::add);
+    stiffness_product.reinit(locally_owned_dofs, mpi_communicator);
 
     // The interior vertices of the owned and ghost cells, each once, by
     // their DoFs (u1, u2).
@@ -73,6 +109,21 @@ namespace membranes
     candidates.erase(std::unique(candidates.begin(), candidates.end()),
                      candidates.end());
 
+    const Epetra_CrsMatrix &epetra = stiffness_matrix.trilinos_matrix();
+    const auto row_l1_norm         = [&](const types::global_dof_index row) {
+      int     n_entries;
+      double *values;
+      int    *columns;
+      epetra.ExtractMyRowView(epetra.LRID(static_cast<long long>(row)),
+                              n_entries,
+                              values,
+                              columns);
+      double norm = 0;
+      for (int k = 0; k < n_entries; ++k)
+        norm += std::abs(values[k]);
+      return norm;
+    };
+
     // V_h: the unconstrained ones; its owned vertices carry λ_a.
     interior_vertices.clear();
     relevant_vertices.clear();
@@ -84,8 +135,10 @@ namespace membranes
           continue;
         relevant_vertices.push_back(dofs);
         if (locally_owned_dofs.is_element(dofs[0]))
-          interior_vertices.push_back(
-            {dofs, dual_cell_measure[dofs[0]], stiffness_diagonal[dofs[0]]});
+          interior_vertices.push_back({dofs,
+                                       dual_cell_measure[dofs[0]],
+                                       stiffness_diagonal[dofs[0]],
+                                       row_l1_norm(dofs[0]) / data.mu[0]});
       }
     interior_vertex_dofs.compress();
 
@@ -101,31 +154,13 @@ namespace membranes
 
   template <int dim>
   void
-  DiscreteAction<dim>::compute(const VectorType &ghosted_solution)
+  DiscreteAction<dim>::compute(const VectorType &solution)
   {
-    // The two terms of (4.5), assembled as vectors over all DoFs:
-    // stiffness_term = A U (μ_i ∫ ∇u_ih·∇φ) and load_term = F (∫ f_i φ).
-    VectorType stiffness_term(locally_owned_dofs, mpi_communicator);
-    VectorType load_term(locally_owned_dofs, mpi_communicator);
-
-    CellSystem<dim>    cell_system(discretization, data);
-    const unsigned int dofs_per_cell = discretization.fe->n_dofs_per_cell();
-    Vector<double>     local_solution(dofs_per_cell);
-    Vector<double>     local_stiffness(dofs_per_cell);
-    for (const auto &cell : dof_handler->active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          cell_system.reinit(cell);
-          for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            local_solution(i) = ghosted_solution[cell_system.dof_indices[i]];
-          cell_system.matrix.vmult(local_stiffness, local_solution);
-          hanging_node_constraints->distribute_local_to_global(
-            local_stiffness, cell_system.dof_indices, stiffness_term);
-          hanging_node_constraints->distribute_local_to_global(
-            cell_system.rhs, cell_system.dof_indices, load_term);
-        }
-    stiffness_term.compress(VectorOperation::add);
-    load_term.compress(VectorOperation::add);
+    // The two terms of (4.5) at every DoF: μ_i ∫ ∇u_ih·∇φ as the product of
+    // the operator with the nodal values (those of hanging nodes follow
+    // from their parents, whose columns hold the condensed couplings), and
+    // the loads ∫ f_i φ of this mesh.
+    stiffness_matrix.vmult(stiffness_product, solution);
 
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
@@ -137,24 +172,33 @@ namespace membranes
         const Vertex &a = interior_vertices[k];
         for (unsigned int i = 0; i < 2; ++i)
           {
-            const double stiffness = stiffness_term[a.dof[i]];
-            const double load      = load_term[a.dof[i]];
+            const double stiffness = stiffness_product[a.dof[i]];
+            const double load      = load_vector[a.dof[i]];
             const double sign      = (i == 0 ? 1. : -1.);
             lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
             stiffness_terms[i][k] = stiffness;
             load_terms[i][k]      = load;
-            const double size =
-              std::max({std::abs(stiffness),
-                        std::abs(load),
-                        data.mu[i] * a.stiffness_diagonal *
-                          std::abs(ghosted_solution[a.dof[i]])});
-            local_max = std::max(local_max, size);
+            const double size     = std::max({std::abs(stiffness),
+                                              std::abs(load),
+                                              data.mu[i] * a.stiffness_diagonal *
+                                                std::abs(solution[a.dof[i]])});
+            local_max             = std::max(local_max, size);
             local_sum_of_squares += size * size;
           }
       }
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
     l2_force =
       std::sqrt(Utilities::MPI::sum(local_sum_of_squares, mpi_communicator));
+  }
+
+
+
+  template <int dim>
+  const double *
+  DiscreteAction<dim>::cell_loads(
+    const typename DoFHandler<dim>::active_cell_iterator &cell) const
+  {
+    return &loads_of_cells[cell->active_cell_index() * loads_per_cell];
   }
 
 

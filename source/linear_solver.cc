@@ -15,6 +15,7 @@ namespace membranes
     : type(type)
     , mpi_communicator(mpi_communicator)
     , use_direct(false)
+    , first_iterations(0)
   {
     if (type == Parameters::LinearSolverType::direct &&
         Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
@@ -39,6 +40,7 @@ namespace membranes
       DoFTools::extract_constant_modes(dof_handler,
                                        ComponentMask(),
                                        constant_modes);
+    amg.reset();
   }
 
 
@@ -48,14 +50,24 @@ namespace membranes
   LinearSolver<dim>::solve(const MatrixType &matrix,
                            VectorType       &x,
                            const VectorType &rhs,
-                           const double      tolerance)
+                           const double      tolerance,
+                           const MatrixType *mesh_matrix)
   {
     if (use_direct)
       {
         solve_direct(matrix, x, rhs);
         return 0;
       }
-    return solve_cg_amg(matrix, x, rhs, tolerance);
+    return solve_cg_amg(matrix, x, rhs, tolerance, mesh_matrix);
+  }
+
+
+
+  template <int dim>
+  bool
+  LinearSolver<dim>::has_mesh_preconditioner() const
+  {
+    return amg != nullptr;
   }
 
 
@@ -116,7 +128,8 @@ namespace membranes
   LinearSolver<dim>::solve_cg_amg(const MatrixType &matrix,
                                   VectorType       &x,
                                   const VectorType &rhs,
-                                  const double      tolerance)
+                                  const double      tolerance,
+                                  const MatrixType *mesh_matrix)
   {
     const double rhs_norm = rhs.l2_norm();
     if (rhs_norm == 0)
@@ -124,17 +137,26 @@ namespace membranes
         x = 0;
         return 0;
       }
-    TrilinosWrappers::PreconditionAMG                 amg;
-    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
-    amg_data.elliptic        = true;
-    amg_data.constant_modes  = constant_modes;
-    amg_data.smoother_sweeps = 2;
-    amg.initialize(matrix, amg_data);
+    const bool build = !amg || !mesh_matrix;
+    if (build)
+      {
+        TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+        amg_data.elliptic        = true;
+        amg_data.constant_modes  = constant_modes;
+        amg_data.smoother_sweeps = 2;
+        amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
+        amg->initialize(mesh_matrix ? *mesh_matrix : matrix, amg_data);
+      }
 
     SolverControl        control(10000, std::max(tolerance, 1e-14 * rhs_norm));
     SolverCG<VectorType> cg(control);
-    cg.solve(matrix, x, rhs, amg);
-    return control.last_step();
+    cg.solve(matrix, x, rhs, *amg);
+    const unsigned int iterations = control.last_step();
+    if (build)
+      first_iterations = iterations;
+    if (!mesh_matrix || iterations > 2 * first_iterations + rebuild_slack)
+      amg.reset();
+    return iterations;
   }
 
 

@@ -1,11 +1,11 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
-#include <deal.II/base/timer.h>
 #include <deal.II/distributed/grid_refinement.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_refinement.h>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <membranes/membrane_problem.h>
 
 namespace membranes
@@ -15,6 +15,7 @@ namespace membranes
     : parameters(parameters)
     , mpi_communicator(MPI_COMM_WORLD)
     , pcout(std::cout, Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
+    , computing_timer(pcout, TimerOutput::never, TimerOutput::wall_times)
     , data(parameters.problem, parameters.exact_solution)
     , discretization(parameters.geometry.cell_type)
     , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
@@ -25,6 +26,7 @@ namespace membranes
                         discretization,
                         data,
                         pcout,
+                        computing_timer,
                         mpi_communicator)
     , error_norms(discretization, data)
     , flux_reconstruction(discretization, data)
@@ -95,6 +97,7 @@ namespace membranes
     action.reinit(dof_handler,
                   hanging_node_constraints,
                   locally_owned_dofs,
+                  locally_relevant_dofs,
                   mpi_communicator);
     active_set_solver.setup(dof_handler,
                             locally_owned_dofs,
@@ -179,8 +182,6 @@ namespace membranes
     record.active_set_iterations = statistics.iterations;
     record.linear_iterations     = statistics.linear_iterations;
     record.kkt_residual          = statistics.kkt_residual;
-    record.time_assembly         = statistics.assembly_time;
-    record.time_solve            = statistics.solve_time;
     record.active_vertices =
       Utilities::MPI::sum(active_set.n_elements(), mpi_communicator);
   }
@@ -281,7 +282,7 @@ namespace membranes
   {
     if (!parameters.output.flux_reconstruction)
       return;
-    Timer timer;
+    TimerOutput::Scope scope(computing_timer, "flux");
     flux_reconstruction.reconstruct(ghosted_solution,
                                     hanging_node_constraints,
                                     action,
@@ -291,7 +292,6 @@ namespace membranes
     record.measure_defect      = identities.measure_defect;
     record.conservation_defect = identities.conservation_defect;
     record.balance_defect      = identities.balance_defect;
-    record.time_flux           = timer.wall_time();
   }
 
 
@@ -320,9 +320,9 @@ namespace membranes
               !parameters.output.flux_reconstruction :
               !(adaptive && driving == kind) && !data.exact_solution_known())
           continue;
-        Timer          timer;
-        Vector<double> kind_indicators;
-        const double   eta = error_estimator.estimate(kind,
+        TimerOutput::Scope scope(computing_timer, flux ? "flux" : "estimate");
+        Vector<double>     kind_indicators;
+        const double       eta = error_estimator.estimate(kind,
                                                     dof_handler,
                                                     ghosted_solution,
                                                     flux_reconstruction,
@@ -334,10 +334,6 @@ namespace membranes
             eta / *record.err_energy;
         if (kind == driving)
           indicators.swap(kind_indicators);
-        if (flux)
-          *record.time_flux += timer.wall_time();
-        else
-          record.time_estimate = timer.wall_time();
       }
   }
 
@@ -492,6 +488,34 @@ namespace membranes
 
 
 
+  /**
+   * The wall time of each phase of this cycle, from the sections of
+   * computing_timer: on several processes that of the slowest process (each
+   * phase ends in communication). The flux reconstruction has a time only
+   * where it was computed.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::record_phase_times()
+  {
+    const std::map<std::string, double> times =
+      computing_timer.get_summary_data(TimerOutput::total_wall_time);
+    const auto time_of = [&](const std::string &section) {
+      const auto time = times.find(section);
+      return Utilities::MPI::max(time == times.end() ? 0. : time->second,
+                                 mpi_communicator);
+    };
+    record.time_setup       = time_of("setup");
+    record.time_assembly    = time_of("assembly");
+    record.time_solve       = time_of("solve");
+    record.time_postprocess = time_of("postprocess");
+    record.time_estimate    = time_of("estimate");
+    if (parameters.output.flux_reconstruction)
+      record.time_flux = time_of("flux");
+  }
+
+
+
   template <int dim>
   void
   MembraneProblem<dim>::run()
@@ -503,7 +527,8 @@ namespace membranes
         record       = CycleRecord();
         record.cycle = cycle;
 
-        Timer timer;
+        computing_timer.reset();
+        TimerOutput::Scope setup_scope(computing_timer, "setup");
         setup_system();
         const auto max_dofs = parameters.refinement.max_dofs;
         if (max_dofs > 0 && dof_handler.n_dofs() > max_dofs)
@@ -520,10 +545,10 @@ namespace membranes
             break;
           }
         transfer_solution();
-        record.time_setup = timer.wall_time();
-        record.cells      = triangulation->n_global_active_cells();
-        record.levels     = triangulation->n_global_levels();
-        record.dofs       = dof_handler.n_dofs();
+        setup_scope.stop();
+        record.cells  = triangulation->n_global_active_cells();
+        record.levels = triangulation->n_global_levels();
+        record.dofs   = dof_handler.n_dofs();
         pcout << "Cycle " << cycle << ": " << record.cells << " cells, "
               << record.dofs << " DoFs";
         if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
@@ -533,24 +558,14 @@ namespace membranes
 
         solve();
 
-        timer.restart();
-        postprocess();
-        record.time_postprocess = timer.wall_time();
+        {
+          TimerOutput::Scope scope(computing_timer, "postprocess");
+          postprocess();
+        }
 
         reconstruct_fluxes();
         estimate_error();
-
-        // On several processes a phase lasts as long as its slowest process
-        // (each ends in communication): report that one's time.
-        for (double *time : {&record.time_setup,
-                             &record.time_assembly,
-                             &record.time_solve,
-                             &record.time_postprocess,
-                             &record.time_estimate})
-          *time = Utilities::MPI::max(*time, mpi_communicator);
-        if (record.time_flux)
-          record.time_flux =
-            Utilities::MPI::max(*record.time_flux, mpi_communicator);
+        record_phase_times();
         record.wall_time = record.time_setup + record.time_assembly +
                            record.time_solve + record.time_postprocess +
                            record.time_estimate +

@@ -3,6 +3,7 @@
 
 #include <deal.II/base/function.h>
 #include <deal.II/base/index_set.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
@@ -25,8 +26,6 @@ namespace membranes
     unsigned int iterations        = 0; ///< Active set iterations.
     unsigned int linear_iterations = 0; ///< CG iterations, summed.
     double       kkt_residual      = 0; ///< Relative KKT residual at the end.
-    double       assembly_time     = 0; ///< Seconds spent assembling.
-    double       solve_time = 0; ///< Seconds in linear solves and updates.
   };
 
 
@@ -45,11 +44,16 @@ namespace membranes
    * w = u1h − u2h.
    *
    * Either way the constraints (hanging nodes, boundary values, contact)
-   * are lines of an AffineConstraints object and the condensed system is
-   * symmetric positive definite: this class holds its matrix, right-hand
-   * side and LinearSolver, and the steps both ways share. Every method adds
-   * the time it spends assembling and solving, and its CG iterations, to
-   * the ActiveSetStatistics it is given.
+   * are those of an AffineConstraints object and the condensed system is
+   * symmetric positive definite. What does not depend on the active set
+   * (the hanging node and boundary constraints, the loads, and for the
+   * decoupled system the whole operator) is built once per mesh, in setup()
+   * and prepare(); solve() only does what the active set changes. This
+   * class holds the matrix and right-hand side of the iteration and the
+   * LinearSolver, and the steps both ways share. Every method times its
+   * assembly and its linear solves in the sections "assembly" and "solve"
+   * of the TimerOutput it is given, and adds its CG iterations to the
+   * ActiveSetStatistics it is given.
    */
   template <int dim>
   class ActiveSetSystem
@@ -60,9 +64,10 @@ namespace membranes
     virtual ~ActiveSetSystem() = default;
 
     /**
-     * Matrices, sparsity patterns and constraints for the current mesh of
-     * @p dof_handler (the DoFHandler of (u1, u2)), with room for any
-     * active set on the vertices of @p action.
+     * Matrices, sparsity patterns and the constraints that do not depend on
+     * the active set, for the current mesh of @p dof_handler (the
+     * DoFHandler of (u1, u2)), with room for any active set on the vertices
+     * of @p action.
      */
     virtual void
     setup(const DoFHandler<dim>     &dof_handler,
@@ -104,16 +109,20 @@ namespace membranes
                     const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,
                     const ProblemData<dim>    &data,
+                    TimerOutput               &timer,
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * Add @p boundary_values, interpolated at the boundary vertices of
-     * @p dof_handler, on all of ∂ω to @p constraints.
+     * Hanging node constraints of @p dof_handler and @p boundary_values,
+     * interpolated at its boundary vertices on all of ∂ω, into
+     * @p constraints (closed): what is constrained on every iteration of a
+     * mesh.
      */
     void
-    add_boundary_values(const DoFHandler<dim>     &dof_handler,
-                        const Function<dim>       &boundary_values,
-                        AffineConstraints<double> &constraints) const;
+    make_mesh_constraints(const DoFHandler<dim>     &dof_handler,
+                          const Function<dim>       &boundary_values,
+                          const IndexSet            &locally_relevant_dofs,
+                          AffineConstraints<double> &constraints) const;
 
     /**
      * Choose the linear solver for @p dof_handler, and size the matrix and
@@ -128,29 +137,32 @@ namespace membranes
                          const IndexSet &locally_relevant_dofs);
 
     /**
-     * Assemble the system, condensed with @p constraints: on every locally
-     * owned cell of @p dof_handler (the DoFHandler of (u1, u2)), CellSystem
-     * is computed and `local_system(cell, cell_system)` returns the tuple
-     * (cell matrix, cell right-hand side, their DoF indices) to add.
+     * Solve `matrix x = rhs` for @p x (starting from it) to a residual norm
+     * of @p tolerance, then set its constrained entries. The AMG hierarchy
+     * is built from @p mesh_matrix if given (a matrix unchanged on this
+     * mesh, kept across solves: LinearSolver), from @p matrix for this
+     * solve alone otherwise.
      */
-    template <typename LocalSystem>
     void
-    assemble_system(const DoFHandler<dim>           &dof_handler,
-                    const AffineConstraints<double> &constraints,
-                    const LocalSystem               &local_system);
+    solve_linear_system(
+      const TrilinosWrappers::SparseMatrix &matrix,
+      const VectorType                     &rhs,
+      const AffineConstraints<double>      &constraints,
+      VectorType                           &x,
+      const double                          tolerance,
+      ActiveSetStatistics                  &statistics,
+      const TrilinosWrappers::SparseMatrix *mesh_matrix = nullptr);
 
     /**
-     * Solve the assembled system for @p x (starting from it) to a residual
-     * norm of @p tolerance, then set its constrained entries.
+     * Whether the AMG hierarchy of a mesh matrix given to an earlier
+     * solve_linear_system() on this mesh is kept for the next one.
      */
-    void
-    solve_linear_system(const AffineConstraints<double> &constraints,
-                        VectorType                      &x,
-                        const double                     tolerance,
-                        ActiveSetStatistics             &statistics);
+    bool
+    has_mesh_preconditioner() const;
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
+    TimerOutput               &timer;
     const MPI_Comm             mpi_communicator;
 
     TrilinosWrappers::SparseMatrix system_matrix;
@@ -160,33 +172,6 @@ namespace membranes
     const std::string method;
     LinearSolver<dim> linear_solver;
   };
-
-
-
-  template <int dim>
-  template <typename LocalSystem>
-  void
-  ActiveSetSystem<dim>::assemble_system(
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &constraints,
-    const LocalSystem               &local_system)
-  {
-    system_matrix = 0;
-    system_rhs    = 0;
-
-    CellSystem<dim> cell_system(discretization, data);
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          cell_system.reinit(cell);
-          const auto [matrix, rhs, dof_indices] =
-            local_system(cell, cell_system);
-          constraints.distribute_local_to_global(
-            matrix, rhs, dof_indices, system_matrix, system_rhs);
-        }
-    system_matrix.compress(VectorOperation::add);
-    system_rhs.compress(VectorOperation::add);
-  }
 } // namespace membranes
 
 #endif

@@ -47,6 +47,25 @@ namespace membranes
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell);
 
+    /**
+     * The same without the loads (`loads` and `rhs` are left as they are):
+     * what does not evaluate the data, for a system whose loads were
+     * computed once per mesh.
+     */
+    void
+    reinit_operator(const typename DoFHandler<dim>::active_cell_iterator &cell);
+
+    /**
+     * Set `loads` and `rhs` from @p cell_loads: F_1K, then F_2K, as
+     * copy_loads() writes them.
+     */
+    void
+    set_loads(const double *cell_loads);
+
+    /** Write F_1K, then F_2K into @p cell_loads (2 n_v entries). */
+    void
+    copy_loads(double *cell_loads) const;
+
     /** A_K of the scalar element. */
     FullMatrix<double> laplace_matrix;
     /** F_1K and F_2K of the scalar element. */

@@ -14,12 +14,14 @@ namespace membranes
    * (u1h, u2h), as deal.II's step-41 does it for one field.
    *
    * On active vertices the contact constraint u1(a) = u2(a) is a line of an
-   * AffineConstraints object, together with hanging-node constraints and
-   * the boundary values u1 = g_h, u2 = g2_h. Condensing the constraint adds
-   * the equations of u1 and u2 at a, so the solution of each iteration
-   * satisfies Prop. 12 (λ from either membrane) by construction; on
-   * inactive vertices both equations hold, i.e. λ_a = 0. The system is
-   * assembled from CellSystem.
+   * AffineConstraints object, merged with the hanging-node constraints and
+   * the boundary values u1 = g_h, u2 = g2_h (built once per mesh).
+   * Condensing the constraint adds the equations of u1 and u2 at a, so the
+   * solution of each iteration satisfies Prop. 12 (λ from either membrane)
+   * by construction; on inactive vertices both equations hold, i.e.
+   * λ_a = 0. The condensed system changes with the active set and is
+   * assembled at every iteration from the cell matrices of CellSystem and
+   * the cell loads, which are computed once per mesh.
    */
   template <int dim>
   class CoupledSystem : public ActiveSetSystem<dim>
@@ -30,11 +32,12 @@ namespace membranes
     CoupledSystem(const Parameters::Solver  &parameters,
                   const Discretization<dim> &discretization,
                   const ProblemData<dim>    &data,
+                  TimerOutput               &timer,
                   const MPI_Comm             mpi_communicator);
 
     /**
-     * Sparsity pattern and matrix for the current mesh; the pattern has room
-     * for any active set.
+     * The hanging node and boundary constraints, sparsity pattern and matrix
+     * for the current mesh; the pattern has room for any active set.
      */
     void
     setup(const DoFHandler<dim>     &dof_handler,
@@ -56,14 +59,12 @@ namespace membranes
           ActiveSetStatistics       &statistics) override;
 
   private:
-    /** Hanging-node, contact and boundary constraints for @p active_set. */
-    void
-    make_constraints(const DiscreteAction<dim> &action,
-                     const IndexSet            &active_set);
-
     SmartPointer<const DoFHandler<dim>> dof_handler;
     IndexSet                            locally_relevant_dofs;
-    AffineConstraints<double>           constraints;
+    /** Hanging node and boundary constraints of the mesh. */
+    AffineConstraints<double> mesh_constraints;
+    /** The same with the contact lines of the current active set. */
+    AffineConstraints<double> constraints;
   };
 } // namespace membranes
 

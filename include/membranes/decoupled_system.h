@@ -47,15 +47,20 @@ namespace membranes
    * problem, on the unconstrained interior vertices.
    *
    * <h3>What one iteration does</h3>
-   * prepare() solves the linear problem for S once per mesh. solve() then
-   * imposes W_a = 0 on the active set (an AffineConstraints line without
-   * entries, merged with the hanging node constraints and W = g_h − g2_h on
-   * ∂ω), solves the obstacle problem's linear system for W (inactive
-   * vertices: Λ_a = 0), and writes U1, U2 into the solution of the
-   * two-component FESystem. ActiveSetSolver computes λ_a by (4.5), the next
-   * active set and the KKT residual from it exactly as for the coupled
-   * system: the test Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the
-   * active set test of this obstacle problem, whose diagonal is μ̄ A_aa.
+   * prepare() assembles, once per mesh, the operator A (condensed with the
+   * hanging node constraints and the boundary values, which are the same
+   * lines for S and for W) and the right-hand sides of S and W, and solves
+   * the linear problem for S. solve() then imposes W_a = 0 on the active
+   * set: in the matrix μ̄ A the rows and columns of the active vertices are
+   * eliminated (what condensing an AffineConstraints line without entries
+   * does), the right-hand side is zeroed there; it solves the obstacle
+   * problem's linear system for W (inactive vertices: Λ_a = 0), and writes
+   * U1, U2 into the solution of the two-component FESystem. Nothing is
+   * assembled and no data are evaluated per iteration. ActiveSetSolver computes
+   * λ_a by (4.5), the next active set and the KKT residual from it exactly as
+   * for the coupled system: the test Λ_a − c_a W_a > 0 with c_a = μ̄
+   * ∫|∇φ_a|²/d_a is the active set test of this obstacle problem, whose
+   * diagonal is μ̄ A_aa.
    *
    * Both scalar problems live on one scalar DoFHandler (the base element of
    * the FESystem, on the same mesh and mapping) and are assembled from the
@@ -72,6 +77,7 @@ namespace membranes
     DecoupledSystem(const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,
                     const ProblemData<dim>    &data,
+                    TimerOutput               &timer,
                     const MPI_Comm             mpi_communicator);
 
     /**
@@ -104,32 +110,24 @@ namespace membranes
 
   private:
     /**
-     * Hanging node constraints, W_a = 0 at the scalar DoFs of the u1 DoFs in
-     * @p active_set, and @p boundary_values on ∂ω, into @p constraints.
+     * The operator A and the right-hand sides of S and of W (without the
+     * contact constraints) on this mesh, condensed with the hanging node
+     * constraints and the boundary values of each.
      */
     void
-    make_constraints(const Function<dim>       &boundary_values,
-                     const IndexSet            &active_set,
-                     AffineConstraints<double> &constraints) const;
-
-    /**
-     * The condensed system of `coefficient · A X = Σ_i load_weights[i] F_i`
-     * for @p constraints.
-     */
-    void
-    assemble_scalar_system(const AffineConstraints<double> &constraints,
-                           const double                     coefficient,
-                           const std::array<double, 2>     &load_weights);
+    assemble_operator();
 
     /** μ1 g + μ2 g2 and g − g2: the boundary values of S and of W. */
     const std::unique_ptr<Function<dim>> sum_boundary_values;
     const std::unique_ptr<Function<dim>> difference_boundary_values;
 
     SmartPointer<const DoFHandler<dim>> dof_handler;
-    DoFHandler<dim>                     scalar_dof_handler;
-    IndexSet                            locally_owned_scalar_dofs;
-    IndexSet                            locally_relevant_scalar_dofs;
-    IndexSet                            locally_relevant_dofs;
+    /** The loads of the mesh are those of this object. */
+    const DiscreteAction<dim> *action;
+    DoFHandler<dim>            scalar_dof_handler;
+    IndexSet                   locally_owned_scalar_dofs;
+    IndexSet                   locally_relevant_scalar_dofs;
+    IndexSet                   locally_relevant_dofs;
     /**
      * The DoFs of u1 and u2 at the vertex of each locally owned scalar DoF,
      * by its position in locally_owned_scalar_dofs. (A vertex has the same
@@ -142,8 +140,24 @@ namespace membranes
      */
     std::vector<types::global_dof_index> scalar_dof;
 
+    /** Hanging node constraints and the boundary values of S, of W. */
     AffineConstraints<double> sum_constraints;
     AffineConstraints<double> difference_constraints;
+
+    /**
+     * A, the Laplacian on the scalar space, and the loads of S (F1 + F2) and
+     * of W ((μ2 F1 − μ1 F2)/M, its boundary values lifted by μ̄ A),
+     * condensed with the constraints of the mesh: assembled once per mesh.
+     */
+    TrilinosWrappers::SparseMatrix laplace_matrix;
+    VectorType                     sum_rhs;
+    VectorType                     difference_rhs;
+
+    /**
+     * The matrix of W at the iteration whose AMG hierarchy the following
+     * iterations of this mesh reuse (LinearSolver).
+     */
+    TrilinosWrappers::SparseMatrix preconditioner_matrix;
 
     /** S = μ1 U1 + μ2 U2 and W = U1 − U2 (locally owned). */
     VectorType sum;

@@ -5,6 +5,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
 #include <membranes/problem_data.h>
@@ -53,24 +54,47 @@ namespace membranes
       double dual_cell_measure;
       /** ∫ |∇φ_a|², the scale of the stiffness matrix at a. */
       double stiffness_diagonal;
+      /**
+       * Σ_b |A_ab|, the l1 norm of the row of a in the Laplacian A
+       * condensed with the hanging node constraints (where the hat function
+       * of a takes its share of those of the hanging vertices it
+       * constrains): the divisor of l1-Jacobi, which converges for every
+       * symmetric positive definite matrix, on any mesh.
+       */
+      double stiffness_row_l1_norm;
     };
 
     DiscreteAction(const Discretization<dim> &discretization,
                    const ProblemData<dim>    &data);
 
     /**
-     * Find V_h and compute d_a on the current mesh. @p hanging_node_constraints
-     * condense the hat functions of constrained vertices into their parents.
+     * Find V_h on the current mesh, and assemble what (4.5) needs of it:
+     * d_a, the operator and the loads. @p hanging_node_constraints condense
+     * the hat functions of constrained vertices into their parents.
      */
     void
     reinit(const DoFHandler<dim>           &dof_handler,
            const AffineConstraints<double> &hanging_node_constraints,
            const IndexSet                  &locally_owned_dofs,
+           const IndexSet                  &locally_relevant_dofs,
            const MPI_Comm                   mpi_communicator);
 
-    /** Compute λ_a by (4.5) from both membranes for @p ghosted_solution. */
+    /**
+     * Compute λ_a by (4.5) from both membranes for @p solution (locally
+     * owned entries, hanging nodes and boundary values set): one product
+     * of the operator of this mesh with @p solution, as step-41 obtains its
+     * contact forces from the residual of the assembled system.
+     */
     void
-    compute(const VectorType &ghosted_solution);
+    compute(const VectorType &solution);
+
+    /**
+     * The loads F_1K, F_2K of the locally owned cell @p cell (CellSystem:
+     * copy_loads(), set_loads()), evaluated once per mesh in reinit().
+     */
+    const double *
+    cell_loads(
+      const typename DoFHandler<dim>::active_cell_iterator &cell) const;
 
     /** The locally owned vertices of V_h. */
     const std::vector<Vertex> &
@@ -140,10 +164,25 @@ namespace membranes
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
 
-    SmartPointer<const DoFHandler<dim>>           dof_handler;
-    SmartPointer<const AffineConstraints<double>> hanging_node_constraints;
-    IndexSet                                      locally_owned_dofs;
-    MPI_Comm                                      mpi_communicator;
+    IndexSet locally_owned_dofs;
+    MPI_Comm mpi_communicator;
+
+    /**
+     * Assembled once per mesh: the operator U ↦ (μ_i ∫ ∇u_ih·∇φ)_φ, block
+     * diagonal in the membranes, and the loads (∫ f_i φ)_φ, both condensed
+     * with the hanging node constraints (boundary DoFs not eliminated: their
+     * values enter the terms of the interior vertices next to ∂ω).
+     */
+    TrilinosWrappers::SparseMatrix stiffness_matrix;
+    VectorType                     load_vector;
+    /**
+     * The cell loads, 2 n_v numbers per cell from active_cell_index() · 2 n_v
+     * on (n_v hat functions per cell).
+     */
+    std::vector<double> loads_of_cells;
+    unsigned int        loads_per_cell;
+    /** The product of stiffness_matrix with the last solution. */
+    VectorType stiffness_product;
 
     std::vector<Vertex>                                 interior_vertices;
     std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;

@@ -34,6 +34,16 @@ namespace membranes
    * meshes), and starts from the vector it is given (the previous active set
    * iterate, or the interpolated solution of the previous mesh), so later
    * iterations of the active set method are cheap.
+   *
+   * The AMG hierarchy is built for each solve, or, if the caller gives a
+   * mesh matrix, once per mesh from that matrix, which the caller keeps
+   * unchanged until the next reinit() (the hierarchy refers to it). The
+   * obstacle problem for w is such a case: its matrices differ from the
+   * operator of the mesh only in the eliminated rows and columns of the
+   * active vertices, so one hierarchy preconditions all of them. While the
+   * CG iterations of a solve stay within twice those of the solve that
+   * built the hierarchy (plus rebuild_slack), it is kept; a solve that
+   * needs more has it rebuilt for the next one.
    */
   template <int dim>
   class LinearSolver
@@ -45,6 +55,9 @@ namespace membranes
     /** Largest problem that `auto` hands to UMFPACK. */
     static constexpr types::global_dof_index direct_solver_dof_limit = 10000;
 
+    /** CG iterations a reused hierarchy may need beyond twice its first. */
+    static constexpr unsigned int rebuild_slack = 5;
+
     /**
      * Throws if @p type is `direct` on more than one process (UMFPACK is
      * serial); this happens before the run, on every process alike.
@@ -52,20 +65,30 @@ namespace membranes
     LinearSolver(const Parameters::LinearSolverType type,
                  const MPI_Comm                     mpi_communicator);
 
-    /** Choose the method for the current problem size. */
+    /** Choose the method for the current problem size; forget the AMG. */
     void
     reinit(const DoFHandler<dim> &dof_handler);
 
     /**
      * Solve `matrix x = rhs`, starting from @p x, to a residual norm of at
-     * most @p tolerance (CG; but never below 1e-14 ‖rhs‖). Returns the
-     * number of CG iterations (0 for the direct solver).
+     * most @p tolerance (CG; but never below 1e-14 ‖rhs‖), preconditioned
+     * by the AMG hierarchy of @p mesh_matrix if given, of @p matrix
+     * otherwise. Returns the number of CG iterations (0 for the direct
+     * solver).
      */
     unsigned int
     solve(const MatrixType &matrix,
           VectorType       &x,
           const VectorType &rhs,
-          const double      tolerance);
+          const double      tolerance,
+          const MatrixType *mesh_matrix);
+
+    /**
+     * Whether the AMG hierarchy of the last mesh matrix given to solve() is
+     * kept for the next solve (always false for the direct solver).
+     */
+    bool
+    has_mesh_preconditioner() const;
 
     /** "direct" or "cg-amg": what the last reinit() chose. */
     std::string
@@ -81,13 +104,19 @@ namespace membranes
     solve_cg_amg(const MatrixType &matrix,
                  VectorType       &x,
                  const VectorType &rhs,
-                 const double      tolerance);
+                 const double      tolerance,
+                 const MatrixType *mesh_matrix);
 
     const Parameters::LinearSolverType type;
     const MPI_Comm                     mpi_communicator;
 
     bool                           use_direct;
     std::vector<std::vector<bool>> constant_modes;
+
+    /** The AMG hierarchy of the mesh matrix, if built. */
+    std::unique_ptr<TrilinosWrappers::PreconditionAMG> amg;
+    /** CG iterations of the solve that built it. */
+    unsigned int first_iterations;
   };
 } // namespace membranes
 

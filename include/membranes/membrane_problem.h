@@ -3,6 +3,7 @@
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/index_set.h>
+#include <deal.II/base/timer.h>
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
@@ -84,10 +85,17 @@ namespace membranes
     output_results(const unsigned int cycle);
     void
     refine_grid();
+    void
+    record_phase_times();
 
     const Parameters::All &parameters;
     MPI_Comm               mpi_communicator;
     ConditionalOStream     pcout;
+    /**
+     * The phases of a cycle: setup, assembly, solve, postprocess, estimate,
+     * flux; reset at the start of each cycle.
+     */
+    TimerOutput computing_timer;
 
     const ProblemData<dim>    data;
     const Discretization<dim> discretization;
