@@ -49,6 +49,9 @@ namespace membranes
                                const IndexSet                 &eliminated,
                                TrilinosWrappers::SparseMatrix &matrix)
     {
+      // Epetra's row views point into the matrices' storage, writable even
+      // through a const matrix: the values of @p matrix are overwritten in
+      // place, its pattern (that of @p base) stays.
       const Epetra_CrsMatrix &from = base.trilinos_matrix();
       const Epetra_CrsMatrix &to   = matrix.trilinos_matrix();
       std::vector<bool>       eliminated_column(from.NumMyCols());
