@@ -275,8 +275,8 @@ namespace membranes
       std::max(solution.linfty_norm(), std::numeric_limits<double>::min());
     const auto &vertices = action.vertices();
 
-    // Projected l1-Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
-    // max(0, W_a − r_a / (μ̄ ‖A_a‖₁)), r_a = λ_a d_a the force of the
+    // Projected Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
+    // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
     // condensed Laplacian; U1 moves by μ2/M and U2 by −μ1/M of the step.
     VectorType iterate = solution;
@@ -289,7 +289,9 @@ namespace membranes
             const double w = iterate[a.dof[0]] - iterate[a.dof[1]];
             const double r = contact_lambda(action, k) * a.dual_cell_measure;
             const double step =
-              std::max(0., w - r / (data.mu_bar * a.stiffness_row_l1_norm)) - w;
+              std::max(0.,
+                       w - 2 * r / (data.mu_bar * a.stiffness_row_l1_norm)) -
+              w;
             iterate[a.dof[0]] += mu2 / M * step;
             iterate[a.dof[1]] -= mu1 / M * step;
           }

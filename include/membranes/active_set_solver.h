@@ -199,16 +199,20 @@ namespace membranes
    * there), and the count grew with refinement (3 4 3 5 6 6 iterations on
    * cycles 1 to 6 of that scene). So when the test wants changes, the next
    * active set is the test applied not to the iterate itself but to a
-   * prediction from it: n_prediction_sweeps sweeps of projected l1-Jacobi
-   * on the obstacle problem for w with s fixed,
+   * prediction from it: n_prediction_sweeps sweeps of projected Jacobi on
+   * the obstacle problem for w with s fixed,
    *
-   *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁)),   r_a = λ_a d_a,
+   *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
    *
    * ‖A_a‖₁ = Σ_b |A_ab| the l1 norm of the row of a in the condensed
    * Laplacian (one product with the operator of DiscreteAction per sweep).
-   * l1-Jacobi converges for every symmetric positive definite matrix, on
-   * any mesh; plain Jacobi (the diagonal A_aa) diverged on the curved,
-   * locally refined cells of the disk. Each sweep carries the contact
+   * Where A is an M-matrix, ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and
+   * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
+   * dominant, hence positive semidefinite, so the sweeps never increase
+   * the energy norm of the error, on any mesh; plain Jacobi diverged on
+   * the curved, locally refined cells of the disk, and l1-Jacobi (the
+   * divisor ‖A_a‖₁) needed more sweeps (4 iterations on Q1 where this
+   * needs 3). Each sweep carries the contact
    * information one layer further: penetrated vertices are clamped and
    * lift their neighbours, active vertices pulled apart are released with
    * the ones behind them. The prediction only proposes; the solve of the
@@ -324,7 +328,7 @@ namespace membranes
      * The locally owned vertices whose status in @p active_set the test
      * Λ_a − c_a W_a > 0 (with the band of indifference) wants to change on
      * the iterate predicted from @p solution by n_prediction_sweeps sweeps
-     * of projected l1-Jacobi (see the class documentation). Leaves in
+     * of projected Jacobi (see the class documentation). Leaves in
      * @p action the λ_a of the prediction.
      */
     std::vector<StatusChange>

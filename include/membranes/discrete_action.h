@@ -58,8 +58,8 @@ namespace membranes
        * Σ_b |A_ab|, the l1 norm of the row of a in the Laplacian A
        * condensed with the hanging node constraints (where the hat function
        * of a takes its share of those of the hanging vertices it
-       * constrains): the divisor of l1-Jacobi, which converges for every
-       * symmetric positive definite matrix, on any mesh.
+       * constrains): half of it is the divisor of the projected Jacobi
+       * sweeps of ActiveSetSolver.
        */
       double stiffness_row_l1_norm;
     };
