@@ -7,6 +7,7 @@
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
+#include <deal.II/grid/grid_tools.h>
 #include <filesystem>
 #include <fstream>
 #include <membranes/discretization.h>
@@ -217,11 +218,13 @@ namespace membranes
     // has it. It is built in place unless it has to be split into
     // triangles, so that manifolds tied to it (the disk's transfinite
     // interior) stay valid; a file is read into a serial triangulation
-    // first, because it may hold triangles, which p4est cannot take.
-    const bool from_file = (geometry.domain == Parameters::Domain::file);
+    // first, because it may hold triangles, which p4est cannot take, and
+    // the slit is rotated there, before p4est takes its coarse cells.
+    const bool serial_first = (geometry.domain == Parameters::Domain::file ||
+                               geometry.domain == Parameters::Domain::slit);
     Triangulation<dim>  serial_coarse;
     Triangulation<dim> &coarse =
-      (want_triangles || from_file) ? serial_coarse : triangulation;
+      (want_triangles || serial_first) ? serial_coarse : triangulation;
     switch (geometry.domain)
       {
         case Parameters::Domain::square:
@@ -229,6 +232,17 @@ namespace membranes
           break;
         case Parameters::Domain::lshape:
           GridGenerator::hyper_L(coarse, -1, 1);
+          break;
+        case Parameters::Domain::slit:
+          // deal.II's slit runs from the bottom edge (0,-1) to the centre;
+          // the quarter turn (x, y) -> (-y, x), exact in floating point,
+          // puts it on [0,1) x {0}. Its four cells do not share the
+          // vertices along the slit: each face of the slit has its own, so
+          // both are boundary.
+          GridGenerator::hyper_cube_slit(coarse, -1, 1);
+          GridTools::transform(
+            [](const Point<dim> &p) { return Point<dim>(-p[1], p[0]); },
+            coarse);
           break;
         case Parameters::Domain::disk:
           GridGenerator::hyper_ball(coarse);
@@ -250,7 +264,7 @@ namespace membranes
         "quadrilateral",
         "the mesh file holds triangles: use 'Cell type = triangle'");
 
-    if (!want_triangles && from_file)
+    if (!want_triangles && serial_first)
       triangulation.copy_triangulation(serial_coarse);
     if (want_triangles)
       {

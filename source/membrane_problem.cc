@@ -316,9 +316,11 @@ namespace membranes
          {Parameters::Estimator::residual, Parameters::Estimator::flux})
       {
         const bool flux = (kind == Parameters::Estimator::flux);
-        if (flux ?
-              !parameters.output.flux_reconstruction :
-              !(adaptive && driving == kind) && !data.exact_solution_known())
+        const bool drives =
+          driving == kind &&
+          (adaptive || parameters.refinement.target_estimator > 0);
+        if (flux ? !parameters.output.flux_reconstruction :
+                   !drives && !data.exact_solution_known())
           continue;
         TimerOutput::Scope scope(computing_timer, flux ? "flux" : "estimate");
         Vector<double>     kind_indicators;
@@ -422,9 +424,13 @@ namespace membranes
    * Global refinement, or adaptive refinement by the estimator's η_K²:
    * bulk (Dörfler) marking refines the fewest cells whose η_K² sum up to
    * the share θ of η², fixed fraction the share θ of the cells with the
-   * largest η_K (coarsening likewise at the other end). The solution and
-   * λ_h are handed to a SolutionTransfer first, to be interpolated onto
-   * the new mesh by transfer_solution().
+   * largest η_K (coarsening likewise at the other end). With `Minimum
+   * growth` g > 1, a marking that refines fewer than the share
+   * (g − 1)/(2^dim − 1) of the cells is extended to that share, again by
+   * the largest η_K: both sets are the cells above a threshold, so the
+   * larger one contains the smaller. The solution and λ_h are handed to a
+   * SolutionTransfer first, to be interpolated onto the new mesh by
+   * transfer_solution().
    */
   template <int dim>
   void
@@ -434,37 +440,53 @@ namespace membranes
     auto *const distributed_triangulation =
       dynamic_cast<parallel::distributed::Triangulation<dim> *>(
         triangulation.get());
+    // Flags the cells by a share @p top at the large end of the indicators
+    // and @p bottom at the small end, of η² (bulk) or of the cells; on
+    // several processes the thresholds are found by a global bisection
+    // instead of a global sort.
+    const auto mark = [&](const Parameters::Marking marking,
+                          const double              top,
+                          const double              bottom) {
+      const bool bulk = (marking == Parameters::Marking::bulk);
+      if (distributed_triangulation && bulk)
+        parallel::distributed::GridRefinement::
+          refine_and_coarsen_fixed_fraction(*distributed_triangulation,
+                                            indicators,
+                                            top,
+                                            bottom);
+      else if (distributed_triangulation)
+        parallel::distributed::GridRefinement::refine_and_coarsen_fixed_number(
+          *distributed_triangulation, indicators, top, bottom);
+      else if (bulk)
+        GridRefinement::refine_and_coarsen_fixed_fraction(*triangulation,
+                                                          indicators,
+                                                          top,
+                                                          bottom);
+      else
+        GridRefinement::refine_and_coarsen_fixed_number(*triangulation,
+                                                        indicators,
+                                                        top,
+                                                        bottom);
+    };
+
     if (refinement.strategy == Parameters::RefinementStrategy::global)
       triangulation->set_all_refine_flags();
-    else if (distributed_triangulation)
-      {
-        // The same marking over the cells of all processes: the thresholds
-        // are found by a global bisection instead of a global sort.
-        if (refinement.marking == Parameters::Marking::bulk)
-          parallel::distributed::GridRefinement::
-            refine_and_coarsen_fixed_fraction(*distributed_triangulation,
-                                              indicators,
-                                              refinement.bulk_parameter,
-                                              refinement.coarsen_fraction);
-        else
-          parallel::distributed::GridRefinement::
-            refine_and_coarsen_fixed_number(*distributed_triangulation,
-                                            indicators,
-                                            refinement.bulk_parameter,
-                                            refinement.coarsen_fraction);
-      }
-    else if (refinement.marking == Parameters::Marking::bulk)
-      GridRefinement::refine_and_coarsen_fixed_fraction(
-        *triangulation,
-        indicators,
-        refinement.bulk_parameter,
-        refinement.coarsen_fraction);
     else
-      GridRefinement::refine_and_coarsen_fixed_number(
-        *triangulation,
-        indicators,
-        refinement.bulk_parameter,
-        refinement.coarsen_fraction);
+      {
+        mark(refinement.marking,
+             refinement.bulk_parameter,
+             refinement.coarsen_fraction);
+        const double least_share =
+          (refinement.minimum_growth - 1) /
+          (GeometryInfo<dim>::max_children_per_cell - 1);
+        unsigned int n_marked = 0;
+        for (const auto &cell : triangulation->active_cell_iterators())
+          if (cell->is_locally_owned() && cell->refine_flag_set())
+            ++n_marked;
+        if (Utilities::MPI::sum(n_marked, mpi_communicator) <
+            least_share * triangulation->n_global_active_cells())
+          mark(Parameters::Marking::fixed_fraction, least_share, 0);
+      }
     triangulation->prepare_coarsening_and_refinement();
 
     previous_mesh_vectors = {ghosted_solution, lambda_h};
@@ -512,6 +534,28 @@ namespace membranes
     record.time_estimate    = time_of("estimate");
     if (parameters.output.flux_reconstruction)
       record.time_flux = time_of("flux");
+  }
+
+
+
+  /**
+   * Whether the estimator of `Refinement/Estimator` of this cycle is at
+   * most `Refinement/Target estimator` (when one is set); says so.
+   */
+  template <int dim>
+  bool
+  MembraneProblem<dim>::target_reached() const
+  {
+    const double target = parameters.refinement.target_estimator;
+    const std::optional<double> &eta =
+      (parameters.refinement.estimator == Parameters::Estimator::flux ?
+         record.flux_estimator :
+         record.estimator);
+    if (!(target > 0 && eta && *eta <= target))
+      return false;
+    pcout << "Stopping: the estimator " << *eta
+          << " <= Target estimator = " << target << std::endl;
+    return true;
   }
 
 
@@ -585,10 +629,13 @@ namespace membranes
           create_output_directory(parameters.output.directory);
         report.add(record);
         output_results(cycle);
+        if (target_reached())
+          break;
         if (cycle + 1 < parameters.refinement.cycles)
           refine_grid();
       }
-    report.print_convergence_table();
+    report.print_convergence_table(parameters.refinement.strategy ==
+                                   Parameters::RefinementStrategy::adaptive);
   }
 
 

@@ -458,10 +458,12 @@ namespace membranes::Parameters
     prm.enter_subsection("Geometry");
     prm.declare_entry("Domain",
                       "square",
-                      Selection("square|lshape|disk|file"),
+                      Selection("square|lshape|slit|disk|file"),
                       "square = (-1,1)^2; lshape = (-1,1)^2 minus [0,1)^2; "
-                      "disk = unit disk (curved boundary kept under "
-                      "refinement); file = the Gmsh mesh in 'Mesh file'.");
+                      "slit = (-1,1)^2 minus the segment [0,1) x {0} (both "
+                      "faces of the slit are boundary); disk = unit disk "
+                      "(curved boundary kept under refinement); file = the "
+                      "Gmsh mesh in 'Mesh file'.");
     prm.declare_entry("Mesh file",
                       "",
                       dealii::Patterns::FileName(),
@@ -487,6 +489,7 @@ namespace membranes::Parameters
     const std::string d = prm.get("Domain");
     domain              = (d == "square" ? Domain::square :
                            d == "lshape" ? Domain::lshape :
+                           d == "slit"   ? Domain::slit :
                            d == "disk"   ? Domain::disk :
                                            Domain::file);
     mesh_file           = prm.get("Mesh file");
@@ -701,6 +704,15 @@ namespace membranes::Parameters
                       "the indicators, with Bulk parameter + Coarsen "
                       "fraction <= 1; 0 = no coarsening (quadrilaterals "
                       "only: deal.II 9.4 cannot coarsen triangles).");
+    prm.declare_entry("Minimum growth",
+                      "1",
+                      Double(1, 4),
+                      "Adaptive refinement refines at least the (Minimum "
+                      "growth - 1)/3 cells with the largest indicators, so "
+                      "that the number of cells grows at least by this "
+                      "factor per cycle (each refined cell makes four); "
+                      "where the marking selects more cells, it stands. "
+                      "1 = the marking alone, 4 = global refinement.");
     prm.declare_entry("Max dofs",
                       "0",
                       Integer(0),
@@ -716,6 +728,14 @@ namespace membranes::Parameters
                       "computed when Strategy = adaptive or when the exact "
                       "solution is known (for the effectivity index), the "
                       "flux estimator whenever the flux reconstruction is.");
+    prm.declare_entry("Target estimator",
+                      "0",
+                      Double(0),
+                      "The run ends after the first cycle whose estimator "
+                      "(the one of 'Estimator', the value of its report "
+                      "column) is at most this value, or after 'Cycles', or "
+                      "before 'Max dofs', whichever comes first; 0 = no "
+                      "target.");
     prm.leave_subsection();
   }
 
@@ -740,9 +760,11 @@ namespace membranes::Parameters
       throw invalid_entry("Refinement/Coarsen fraction",
                           prm.get("Coarsen fraction"),
                           "Bulk parameter + Coarsen fraction must be <= 1");
-    max_dofs = prm.get_integer("Max dofs");
+    minimum_growth = get_double(prm, "Refinement", "Minimum growth");
+    max_dofs       = prm.get_integer("Max dofs");
     estimator =
       (prm.get("Estimator") == "flux" ? Estimator::flux : Estimator::residual);
+    target_estimator = get_double(prm, "Refinement", "Target estimator");
     prm.leave_subsection();
   }
 

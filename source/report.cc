@@ -154,7 +154,7 @@ namespace membranes
 
 
   void
-  Report::print_convergence_table()
+  Report::print_convergence_table(const bool rates_in_dofs)
   {
     ConvergenceTable               table;
     const auto                    &names = column_names();
@@ -203,12 +203,20 @@ namespace membranes
           table.set_scientific(column, true);
           if (column.rfind("err_", 0) == 0)
             table.evaluate_convergence_rates(
-              column, "dofs", ConvergenceTable::reduction_rate_log2, 2);
+              column,
+              "dofs",
+              ConvergenceTable::reduction_rate_log2,
+              rates_in_dofs ? 1 : 2);
         }
     table.set_precision("cumulative_wall_time_s", 2);
     if (pcout.is_active())
       {
-        pcout << std::endl;
+        pcout << std::endl
+              << (rates_in_dofs ?
+                    "Observed rates (red.rate.log2) in DoFs: e ~ N^-rate" :
+                    "Observed rates (red.rate.log2) in h: e ~ h^rate, "
+                    "h ~ N^-1/2")
+              << std::endl;
         table.write_text(pcout.get_stream(),
                          TableHandler::TextOutputFormat::org_mode_table);
       }

@@ -71,6 +71,12 @@ CASES = [
     ("Bulk parameter = 0",
      "subsection Refinement\n  set Bulk parameter = 0\nend\n", [],
      ["Refinement/Bulk parameter"]),
+    ("Minimum growth below 1",
+     "subsection Refinement\n  set Minimum growth = 0.5\nend\n", [],
+     ["Refinement/Minimum growth"]),
+    ("Target estimator negative",
+     "", ["--set", "Refinement/Target estimator=-1"],
+     ["Refinement/Target estimator"]),
     ("Max dofs below the first mesh",
      "subsection Refinement\n  set Max dofs = 10\nend\n", [],
      ["Refinement/Max dofs"]),
@@ -135,7 +141,9 @@ def check_good_command_lines(membranes):
              "lambda", "u1 gradient", "u2 gradient", "Method",
              "Linear solver", "Tolerance", "Max active set iterations",
              "Strategy", "Cycles", "Marking",
-             "Bulk parameter", "Coarsen fraction", "Max dofs", "Estimator", "Directory", "Report",
+             "Bulk parameter", "Coarsen fraction", "Minimum growth",
+             "Max dofs", "Estimator", "Target estimator", "Directory",
+             "Report",
              "Write vtu", "Write nodal values", "Flux reconstruction"]
     missing = [n for n in names if "set %s " % n not in printed.stdout]
     ok &= printed.returncode == 0 and not missing

@@ -16,6 +16,9 @@ Checks (COL is a column name from the header, VALUE a number):
     Observed convergence rate in h of COL over the last two rows,
     ``log(e_{k-1} / e_k) / log(sqrt(N_k / N_{k-1}))`` with N the ``dofs``
     column (two dimensions, so h ~ N^{-1/2}).
+``--max-rate COL<=VALUE``
+    The same rate in h is at most VALUE (a singular solution that uniform
+    refinement cannot approximate faster).
 ``--dof-rate COL>=VALUE``
     Observed rate in DoFs of COL, ``e ~ N^{-rate}``: the least-squares slope
     of log(COL) against log(N) over the last half of the rows (at least
@@ -36,6 +39,9 @@ Checks (COL is a column name from the header, VALUE a number):
     Every value of COL is empty.
 ``--filled COL``
     Every value of COL is non-empty.
+``--growth COL>=VALUE``
+    Every value of COL after the first is at least VALUE times the one
+    before (e.g. the growth of ``cells`` per cycle).
 ``--rows N``
     The file has exactly N data rows.
 ``--decreasing COL``
@@ -161,24 +167,58 @@ def non_negative_int(text):
 
 # Each check takes (report, argument) and returns (passed, message).
 
-def check_rate(report, arg):
-    """Observed rate in h of a column over the last two rows."""
-    column, bound = arg
+def rate_in_h(report, column):
+    """(rate or None, message): observed rate in h of a column over the
+    last two rows."""
     if len(report.rows) < 2:
-        return False, f"needs at least 2 rows, the file has {len(report.rows)}"
+        return None, f"needs at least 2 rows, the file has {len(report.rows)}"
     dofs = report.values(DOFS)[-2:]
     errors = report.values(column)[-2:]
     detail = (f"(dofs {fmt(dofs[0])} -> {fmt(dofs[1])}, "
               f"{column} {fmt(errors[0])} -> {fmt(errors[1])})")
     if None in dofs or None in errors:
-        return False, f"rate undefined: empty value {detail}"
+        return None, f"rate undefined: empty value {detail}"
     if not (0 < dofs[0] < dofs[1]):
-        return False, f"rate undefined: dofs must increase {detail}"
+        return None, f"rate undefined: dofs must increase {detail}"
     if not (errors[0] > 0 and errors[1] > 0):
-        return False, f"rate undefined: errors must be positive {detail}"
+        return None, f"rate undefined: errors must be positive {detail}"
     rate = math.log(errors[0] / errors[1]) / math.log(
         math.sqrt(dofs[1] / dofs[0]))
-    return rate >= bound, f"rate {rate:.4g}, bound >= {fmt(bound)} {detail}"
+    return rate, f"rate {rate:.4g} {detail}"
+
+
+def check_rate(report, arg):
+    """Observed rate in h of a column over the last two rows >= bound."""
+    column, bound = arg
+    rate, message = rate_in_h(report, column)
+    if rate is None:
+        return False, message
+    return rate >= bound, f"{message}, bound >= {fmt(bound)}"
+
+
+def check_max_rate(report, arg):
+    """Observed rate in h of a column over the last two rows <= bound."""
+    column, bound = arg
+    rate, message = rate_in_h(report, column)
+    if rate is None:
+        return False, message
+    return rate <= bound, f"{message}, bound <= {fmt(bound)}"
+
+
+def check_growth(report, arg):
+    """Each value after the first >= bound times the one before."""
+    column, bound = arg
+    values = report.values(column)
+    if len(values) < 2 or None in values or min(values) <= 0:
+        return False, f"needs at least 2 positive values, got {values}"
+    ratios = [later / earlier for earlier, later in zip(values, values[1:])]
+    bad = [f"row {row + 1}: {ratio:.4g}" for row, ratio in enumerate(ratios)
+           if not ratio >= bound]
+    message = (f"least growth {min(ratios):.4g} over {len(ratios)} steps, "
+               f"bound >= {fmt(bound)}")
+    if bad:
+        message += f"; violated at {', '.join(bad)}"
+    return not bad, message
 
 
 def check_dof_rate(report, arg):
@@ -322,6 +362,10 @@ def check_decreasing(report, column):
 CHECKS = {
     "--rate": (check_rate, lambda s: split_bound(s, ">="),
                lambda a: f"{a[0]}>={fmt(a[1])}"),
+    "--max-rate": (check_max_rate, lambda s: split_bound(s, "<="),
+                   lambda a: f"{a[0]}<={fmt(a[1])}"),
+    "--growth": (check_growth, lambda s: split_bound(s, ">="),
+                 lambda a: f"{a[0]}>={fmt(a[1])}"),
     "--dof-rate": (check_dof_rate, lambda s: split_bound(s, ">="),
                    lambda a: f"{a[0]}>={fmt(a[1])}"),
     "--band": (check_band, lambda s: split_bound(s, "<="),
@@ -343,7 +387,8 @@ CHECKS = {
     "--decreasing": (check_decreasing, str, str),
 }
 
-METAVARS = {"--rate": "COL>=VALUE", "--dof-rate": "COL>=VALUE",
+METAVARS = {"--rate": "COL>=VALUE", "--max-rate": "COL<=VALUE",
+            "--growth": "COL>=VALUE", "--dof-rate": "COL>=VALUE",
             "--band": "COL<=VALUE", "--max": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
             "--max-last": "COL<=VALUE", "--min-last": "COL>=VALUE",
@@ -375,10 +420,10 @@ def parse_arguments(argv):
 
 def columns_of(option, argument):
     """The columns a check refers to."""
-    if option in ("--rate", "--dof-rate"):
+    if option in ("--rate", "--max-rate", "--dof-rate"):
         return [argument[0], DOFS]
     if option in ("--max", "--min", "--max-after-first", "--max-last",
-                  "--min-last", "--band"):
+                  "--min-last", "--band", "--growth"):
         return [argument[0]]
     if option == "--rows":
         return []

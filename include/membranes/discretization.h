@@ -65,7 +65,9 @@ namespace membranes
 
   /**
    * The coarse mesh of the scene's domain, refined `Initial refinement`
-   * times: the square (−1,1)², the L-shape (−1,1)² minus [0,1)², the unit
+   * times: the square (−1,1)², the L-shape (−1,1)² minus [0,1)², the
+   * slit domain (−1,1)² minus [0,1) × {0} (four cells, the vertices on the
+   * slit doubled, so that both of its faces are boundary), the unit
    * disk (its circle kept as a SphericalManifold, so refinement follows the
    * curved boundary), or a Gmsh file. Quadrilateral meshes are split into
    * triangles (GridGenerator::convert_hypercube_to_simplex_mesh) when the

@@ -83,6 +83,8 @@ namespace membranes
     write_unconverged_iterate();
     void
     output_results(const unsigned int cycle);
+    bool
+    target_reached() const;
     void
     refine_grid();
     void

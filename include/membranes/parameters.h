@@ -89,6 +89,7 @@ namespace membranes::Parameters
   {
     square,
     lshape,
+    slit,
     disk,
     file
   };
@@ -207,8 +208,10 @@ namespace membranes::Parameters
     Marking            marking;    ///< Dörfler (bulk) or fixed fraction.
     double       bulk_parameter;   ///< θ: share of η² (bulk) or of cells.
     double       coarsen_fraction; ///< The same for coarsening; 0 = none.
+    double       minimum_growth;   ///< Least growth factor of the cells.
     unsigned int max_dofs;         ///< Stop before exceeding; 0 = no limit.
     Estimator    estimator;        ///< Which a posteriori estimator drives it.
+    double       target_estimator; ///< Stop once η <= this; 0 = no target.
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -87,9 +87,16 @@ namespace membranes
     void
     add(const CycleRecord &record);
 
-    /** Print the table with convergence rates. */
+    /**
+     * Print the table with the observed convergence rates of the error
+     * columns, computed by ConvergenceTable against `dofs`: with
+     * @p rates_in_dofs the rate r of e ~ N^(−r) in the number N of DoFs
+     * (adaptive meshes have no one h), otherwise the rate in h of
+     * e ~ h^r, as 2 r with h ~ N^(−1/2) (uniform refinement halves h).
+     * A line above the table says which.
+     */
     void
-    print_convergence_table();
+    print_convergence_table(const bool rates_in_dofs);
 
     /** The column names of report.csv, in order. */
     static const std::vector<std::string> &
