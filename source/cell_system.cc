@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <membranes/cell_system.h>
 
 namespace membranes
@@ -47,11 +48,21 @@ namespace membranes
       {
         data.load(i).value_list(fe_values.get_quadrature_points(),
                                 load_values[i]);
-        loads[i] = 0;
+        loads[i]       = 0;
+        double measure = 0, integral = 0;
         for (const unsigned int q : fe_values.quadrature_point_indices())
-          for (const unsigned int v : fe_values.dof_indices())
-            loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
-                           fe_values.JxW(q);
+          {
+            measure += fe_values.JxW(q);
+            integral += load_values[i][q] * fe_values.JxW(q);
+            for (const unsigned int v : fe_values.dof_indices())
+              loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
+                             fe_values.JxW(q);
+          }
+        load_mean[i]        = integral / measure;
+        load_oscillation[i] = 0;
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          load_oscillation[i] +=
+            std::pow(load_values[i][q] - load_mean[i], 2) * fe_values.JxW(q);
       }
     for (unsigned int j = 0; j < dof_indices.size(); ++j)
       rhs(j) = loads[membrane[j]](scalar_index[j]);
@@ -112,11 +123,22 @@ namespace membranes
 
 
   template <int dim>
+  unsigned int
+  CellSystem<dim>::n_load_entries() const
+  {
+    return 2 * laplace_matrix.m() + 4;
+  }
+
+
+
+  template <int dim>
   void
   CellSystem<dim>::copy_loads(double *cell_loads) const
   {
     for (const auto &load : loads)
       cell_loads = std::copy(load.begin(), load.end(), cell_loads);
+    cell_loads = std::copy(load_mean.begin(), load_mean.end(), cell_loads);
+    std::copy(load_oscillation.begin(), load_oscillation.end(), cell_loads);
   }
 
 

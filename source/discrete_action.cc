@@ -65,7 +65,7 @@ namespace membranes
     CellSystem<dim>    cell_system(discretization, data);
     const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
     Vector<double>     local_stiffness(dofs_per_cell);
-    loads_per_cell = 2 * fe.base_element(0).n_dofs_per_cell();
+    loads_per_cell = cell_system.n_load_entries();
     loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
                             loads_per_cell,
                           0.);
@@ -189,6 +189,19 @@ namespace membranes
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
     l2_force =
       std::sqrt(Utilities::MPI::sum(local_sum_of_squares, mpi_communicator));
+  }
+
+
+
+  template <int dim>
+  std::pair<double, double>
+  DiscreteAction<dim>::load_mean_and_oscillation(
+    const typename DoFHandler<dim>::active_cell_iterator &cell,
+    const unsigned int                                    i) const
+  {
+    const double *statistics =
+      cell_loads(cell) + loads_per_cell - 4; // f̄_1K, f̄_2K, osc_1K, osc_2K
+    return {statistics[i], statistics[2 + i]};
   }
 
 

@@ -10,9 +10,11 @@ namespace membranes
 {
   template <int dim>
   ErrorEstimator<dim>::ErrorEstimator(const Discretization<dim> &discretization,
-                                      const ProblemData<dim>    &data)
+                                      const ProblemData<dim>    &data,
+                                      const DiscreteAction<dim> &action)
     : discretization(discretization)
     , data(data)
+    , action(action)
   {}
 
 
@@ -63,19 +65,13 @@ namespace membranes
     const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
     // derivatives, Q1 ones do on non-affine cells.
-    const bool    with_laplacians = !fe.reference_cell().is_simplex();
-    FEValues<dim> fe_values(*discretization.mapping,
+    const bool         with_laplacians = !fe.reference_cell().is_simplex();
+    FEValues<dim>      fe_values(*discretization.mapping,
                             fe,
                             flux_reconstruction.dual_quadrature().quadrature(),
                             update_values | update_JxW_values |
                               (with_laplacians ? update_hessians :
-                                                 update_default));
-    // The loads on the cell quadrature of the assembly, for f_ih and the
-    // oscillation.
-    FEValues<dim>      load_values(*discretization.mapping,
-                              fe,
-                              discretization.cell_quadrature,
-                              update_quadrature_points | update_JxW_values);
+                                                      update_default));
     const unsigned int n_q_points = fe_values.n_quadrature_points;
     std::array<std::vector<double>, 2> u, laplacian;
     for (unsigned int i = 0; i < 2; ++i)
@@ -84,14 +80,12 @@ namespace membranes
         laplacian[i].assign(n_q_points, 0.0);
       }
     std::vector<double>         lambda(n_q_points);
-    std::vector<double>         f(load_values.n_quadrature_points);
     const std::array<double, 2> sign{{1., -1.}};
 
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          load_values.reinit(cell);
           flux_reconstruction.lambda_h_values(cell, lambda);
 
           const double h_K     = cell->diameter();
@@ -105,19 +99,10 @@ namespace membranes
                 fe_values[membrane].get_function_laplacians(ghosted_solution,
                                                             laplacian[i]);
 
-              data.load(i).value_list(load_values.get_quadrature_points(), f);
-              double measure = 0, f_mean = 0;
-              for (const unsigned int q :
-                   load_values.quadrature_point_indices())
-                {
-                  measure += load_values.JxW(q);
-                  f_mean += f[q] * load_values.JxW(q);
-                }
-              f_mean /= measure;
-              double oscillation = 0;
-              for (const unsigned int q :
-                   load_values.quadrature_point_indices())
-                oscillation += std::pow(f[q] - f_mean, 2) * load_values.JxW(q);
+              // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
+              // assembly.
+              const auto [f_mean, oscillation] =
+                action.load_mean_and_oscillation(cell, i);
 
               double residual = 0;
               for (unsigned int q = 0; q < n_q_points; ++q)

@@ -30,7 +30,7 @@ namespace membranes
                         mpi_communicator)
     , error_norms(discretization, data)
     , flux_reconstruction(discretization, data)
-    , error_estimator(discretization, data)
+    , error_estimator(discretization, data, action)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
   {}

@@ -62,7 +62,14 @@ namespace membranes
     void
     set_loads(const double *cell_loads);
 
-    /** Write F_1K, then F_2K into @p cell_loads (2 n_v entries). */
+    /** The number of entries that copy_loads() writes: 2 n_v + 4. */
+    unsigned int
+    n_load_entries() const;
+
+    /**
+     * Write F_1K, then F_2K into @p cell_loads (2 n_v entries), followed
+     * by load_mean and load_oscillation (2 entries each).
+     */
     void
     copy_loads(double *cell_loads) const;
 
@@ -70,6 +77,12 @@ namespace membranes
     FullMatrix<double> laplace_matrix;
     /** F_1K and F_2K of the scalar element. */
     std::array<Vector<double>, 2> loads;
+    /**
+     * The mean f̄_iK = ∫_K f_i / |K| and the oscillation ∫_K (f_i − f̄_iK)²
+     * of each load, with the quadrature of F_iK (set by reinit()): the data
+     * terms of the residual estimator, from the same evaluations.
+     */
+    std::array<double, 2> load_mean, load_oscillation;
 
     FullMatrix<double>                   matrix;
     Vector<double>                       rhs;

@@ -9,6 +9,7 @@
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
 #include <membranes/problem_data.h>
+#include <utility>
 #include <vector>
 
 namespace membranes
@@ -96,6 +97,16 @@ namespace membranes
     cell_loads(
       const typename DoFHandler<dim>::active_cell_iterator &cell) const;
 
+    /**
+     * The mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of load @p i on
+     * the locally owned cell @p cell (CellSystem::load_mean,
+     * CellSystem::load_oscillation), evaluated with the cell loads.
+     */
+    std::pair<double, double>
+    load_mean_and_oscillation(
+      const typename DoFHandler<dim>::active_cell_iterator &cell,
+      const unsigned int                                    i) const;
+
     /** The locally owned vertices of V_h. */
     const std::vector<Vertex> &
     vertices() const;
@@ -176,7 +187,8 @@ namespace membranes
     TrilinosWrappers::SparseMatrix stiffness_matrix;
     VectorType                     load_vector;
     /**
-     * The cell loads, 2 n_v numbers per cell from active_cell_index() · 2 n_v
+     * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
+     * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
      * on (n_v hat functions per cell).
      */
     std::vector<double> loads_of_cells;

@@ -5,6 +5,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
+#include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
 #include <membranes/flux_reconstruction.h>
 #include <membranes/parameters.h>
@@ -110,8 +111,13 @@ namespace membranes
   public:
     using VectorType = TrilinosWrappers::MPI::Vector;
 
+    /**
+     * The data enter through @p action: the means and oscillations of the
+     * loads per cell, evaluated once per mesh with the cell loads.
+     */
     ErrorEstimator(const Discretization<dim> &discretization,
-                   const ProblemData<dim>    &data);
+                   const ProblemData<dim>    &data,
+                   const DiscreteAction<dim> &action);
 
     /**
      * Fill @p indicators (indexed by active_cell_index(), zero on cells
@@ -151,6 +157,7 @@ namespace membranes
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
+    const DiscreteAction<dim> &action;
   };
 } // namespace membranes
 
