@@ -238,36 +238,34 @@ def compare(label, dofs_ratio, time_ratio, uniform_path, adaptive_paths):
     print_table(header, body)
     print()
 
+    def at_most(value, bound):
+        return value is not None and value <= bound
+
     uniform_values, adaptive_values = measured[0], measured[1]
     checks = [
-        (adaptive_values["n_ratio"] is not None
-         and adaptive_values["n_ratio"] <= dofs_ratio,
+        (at_most(adaptive_values["n_ratio"], dofs_ratio),
          f"DoF ratio at equal error <= {dofs_ratio:g}: "
          f"{ratio(adaptive_values['n_ratio'])}"),
-        (adaptive_values["t_ratio"] is not None
-         and adaptive_values["t_ratio"] <= time_ratio,
+        (at_most(adaptive_values["t_ratio"], time_ratio),
          f"cumulative time ratio at equal error <= {time_ratio:g}: "
          f"{ratio(adaptive_values['t_ratio'])}"),
         ((adaptive_values["rate"] or 0) >= MIN_ADAPTIVE_RATE,
          f"adaptive rate in N >= {MIN_ADAPTIVE_RATE}: "
          f"{fmt(adaptive_values['rate'], '.3f')}"),
-        (adaptive_values["cost_ratio"] <= MAX_COST_RATIO,
+        (at_most(adaptive_values["cost_ratio"], MAX_COST_RATIO),
          f"adaptive cost per final DoF <= {MAX_COST_RATIO} x uniform: "
-         f"{adaptive_values['cost_ratio']:.2f}")]
+         f"{fmt(adaptive_values['cost_ratio'], '.2f')}")]
     for name, values in (("uniform", uniform_values),
                          ("adaptive", adaptive_values)):
+        share = values["share"]
         checks += [
-            (values["iterations"] is not None
-             and values["iterations"] <= MAX_ACTIVE_SET_ITERATIONS,
+            (at_most(values["iterations"], MAX_ACTIVE_SET_ITERATIONS),
              f"{name}: active-set iterations after the first cycle <= "
              f"{MAX_ACTIVE_SET_ITERATIONS}: {fmt(values['iterations'], 'd')}"),
-            (values["share"] is not None
-             and values["share"] <= MAX_ESTIMATOR_SHARE,
+            (at_most(share, MAX_ESTIMATOR_SHARE),
              f"{name}: estimator <= {100 * MAX_ESTIMATOR_SHARE:g} % of a "
-             f"cycle: " + ("-" if values["share"] is None
-                           else f"{100 * values['share']:.1f} %")),
-            (values["band"] is not None
-             and values["band"] <= MAX_EFFECTIVITY_BAND,
+             f"cycle: " + ("-" if share is None else f"{100 * share:.1f} %")),
+            (at_most(values["band"], MAX_EFFECTIVITY_BAND),
              f"{name}: effectivity band max/min <= {MAX_EFFECTIVITY_BAND}: "
              f"{fmt(values['band'], '.3f')}")]
     for passed, text in checks:
