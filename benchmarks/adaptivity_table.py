@@ -46,6 +46,7 @@ Exit status 1 if a target is missed or a report lacks a column it needs.
 
 import csv
 import math
+import os
 import sys
 
 from solver_cost_table import fmt, number, print_table
@@ -209,7 +210,9 @@ def compare(label, dofs_ratio, time_ratio, uniform_path, adaptive_paths):
               "rate in N", "last err sqrt(N)", "us/DoF", "us/DoF / uniform",
               "effectivity band", "max AS its", "max estimate share"]
     body, measured = [], []
-    for name, rows in [("uniform", uniform)] + runs:
+    named = [(os.path.basename(os.path.dirname(os.path.abspath(path))), rows)
+             for path, rows in runs]
+    for name, rows in [("uniform", uniform)] + named:
         reached = at_error(rows, target) if name != "uniform" else None
         r, _, _ = rate(rows)
         last = rows[-1]
