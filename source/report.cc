@@ -209,14 +209,19 @@ namespace membranes
               rates_in_dofs ? 1 : 2);
         }
     table.set_precision("cumulative_wall_time_s", 2);
+    const bool with_rates =
+      std::any_of(filled.begin(), filled.end(), [](const std::string &c) {
+        return c.rfind("err_", 0) == 0;
+      });
     if (pcout.is_active())
       {
-        pcout << std::endl
-              << (rates_in_dofs ?
-                    "Observed rates (red.rate.log2) in DoFs: e ~ N^-rate" :
-                    "Observed rates (red.rate.log2) in h: e ~ h^rate, "
-                    "h ~ N^-1/2")
-              << std::endl;
+        pcout << std::endl;
+        if (with_rates)
+          pcout << (rates_in_dofs ?
+                      "Observed rates (red.rate.log2) in DoFs: e ~ N^-rate" :
+                      "Observed rates (red.rate.log2) in h: e ~ h^rate, "
+                      "h ~ N^-1/2")
+                << std::endl;
         table.write_text(pcout.get_stream(),
                          TableHandler::TextOutputFormat::org_mode_table);
       }
