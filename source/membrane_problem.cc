@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <membranes/membrane_problem.h>
+#include <unistd.h>
 
 namespace membranes
 {
@@ -42,8 +43,69 @@ namespace membranes
   void
   MembraneProblem<dim>::make_grid()
   {
+    check_output_directory();
     create_mesh(parameters.geometry, *triangulation);
     data.check_boundary_data(*triangulation);
+    data.check_exact_solution(*triangulation,
+                              *discretization.mapping,
+                              discretization.cell_quadrature);
+  }
+
+
+
+  /**
+   * Whether `Output/Directory` can be created, found out before the first
+   * cycle and without leaving anything behind: every part of its path that
+   * exists must be a directory, and in the deepest one that exists a
+   * directory must be creatable (a probe, removed at once; a read-only or
+   * virtual file system such as /proc refuses it). The directory itself is
+   * created after the first cycle (create_output_directory()).
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::check_output_directory() const
+  {
+    namespace fs = std::filesystem;
+    std::string problem;
+    if (pcout.is_active())
+      {
+        std::error_code error;
+        const fs::path  directory =
+          fs::absolute(fs::path(parameters.output.directory).lexically_normal(),
+                       error);
+        // Up to the deepest part of the path that exists; any other error
+        // than a missing part (a file in the path, no permission) is the
+        // answer.
+        fs::path existing = directory;
+        while (!error &&
+               fs::status(existing, error).type() == fs::file_type::not_found &&
+               existing != existing.parent_path())
+          {
+            error.clear();
+            existing = existing.parent_path();
+          }
+        // The probe: the first missing part of the path itself (its name
+        // may be too long), or a new name inside the existing directory.
+        const fs::path probe =
+          existing == directory ?
+            existing / (".membranes-probe-" + std::to_string(::getpid())) :
+            existing / *fs::relative(directory, existing).begin();
+        if (error)
+          problem = error.message();
+        else if (!fs::is_directory(existing))
+          problem = existing.string() + " is not a directory";
+        else if (!fs::create_directory(probe, error))
+          problem = "no directory can be made in " + existing.string() +
+                    (error ? " (" + error.message() + ")" : "");
+        else
+          fs::remove(probe, error);
+      }
+    problem = Utilities::MPI::broadcast(mpi_communicator, problem, 0);
+    if (!problem.empty())
+      throw Parameters::invalid_entry("Output/Directory",
+                                      parameters.output.directory,
+                                      "cannot create this directory (" +
+                                        problem + ")");
   }
 
 

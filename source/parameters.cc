@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <deal.II/base/utilities.h>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,72 @@ namespace membranes::Parameters
   using dealii::Patterns::Selection;
   using dealii::Utilities::trim;
 
+  namespace
+  {
+    /**
+     * The length of the valid UTF-8 sequence at @p i of @p text and its
+     * code point; length 0 if the bytes there are not one.
+     */
+    std::pair<std::size_t, char32_t>
+    utf8_at(const std::string &text, const std::size_t i)
+    {
+      const auto        c      = static_cast<unsigned char>(text[i]);
+      const std::size_t length = (c < 0x80           ? 1 :
+                                  (c & 0xe0) == 0xc0 ? 2 :
+                                  (c & 0xf0) == 0xe0 ? 3 :
+                                  (c & 0xf8) == 0xf0 ? 4 :
+                                                       0);
+      if (length == 0 || i + length > text.size())
+        return {0, 0};
+      char32_t point = (length == 1 ? c : c & (0x7f >> length));
+      for (std::size_t k = 1; k < length; ++k)
+        {
+          const auto d = static_cast<unsigned char>(text[i + k]);
+          if ((d & 0xc0) != 0x80)
+            return {0, 0};
+          point = (point << 6) | (d & 0x3f);
+        }
+      return {length, point};
+    }
+
+    /**
+     * Whether @p point is shown as a visible character: not a control
+     * character (C0, DEL, C1), not a space other than ' ', not an invisible
+     * format character (soft hyphen, zero-width and direction marks, byte
+     * order mark), not a surrogate or a noncharacter.
+     */
+    bool
+    is_visible(const char32_t point)
+    {
+      const std::pair<char32_t, char32_t> hidden[] = {{0x0, 0x20},
+                                                      {0x7f, 0xa0},
+                                                      {0xad, 0xad},
+                                                      {0x600, 0x605},
+                                                      {0x61c, 0x61c},
+                                                      {0x6dd, 0x6dd},
+                                                      {0x70f, 0x70f},
+                                                      {0x1680, 0x1680},
+                                                      {0x180e, 0x180e},
+                                                      {0x2000, 0x200f},
+                                                      {0x2028, 0x202f},
+                                                      {0x205f, 0x206f},
+                                                      {0x3000, 0x3000},
+                                                      {0xd800, 0xdfff},
+                                                      {0xfeff, 0xfeff},
+                                                      {0xfff9, 0xfffb},
+                                                      {0xfffe, 0xffff},
+                                                      {0x110000, 0xffffffff}};
+      return std::none_of(std::begin(hidden),
+                          std::end(hidden),
+                          [point](const auto &range) {
+                            return range.first <= point &&
+                                   point <= range.second;
+                          });
+    }
+  } // namespace
+
+
+
   std::string
   one_line_message(const std::exception &error)
   {
@@ -27,19 +94,43 @@ namespace membranes::Parameters
       dealii_error->print_info(text);
     else
       text << error.what();
-    std::string line;
-    bool        blank = false;
-    for (const char c : text.str())
-      if (std::isspace(static_cast<unsigned char>(c)) ||
-          std::iscntrl(static_cast<unsigned char>(c)))
-        blank = !line.empty();
-      else
-        {
-          if (blank)
-            line += ' ';
-          line += c;
-          blank = false;
-        }
+
+    // Runs of blanks and control characters become one blank; visible
+    // characters (UTF-8) stay; anything else (an invisible character, or
+    // bytes of a binary file that a parser quotes) is written as \xNN per
+    // byte, so that the line is printable text.
+    const std::string message = text.str();
+    std::string       line;
+    bool              blank = false;
+    for (std::size_t i = 0; i < message.size();)
+      {
+        const auto [length, point] = utf8_at(message, i);
+        if (length == 1 && (std::isspace(point) || std::iscntrl(point)))
+          {
+            blank = !line.empty();
+            ++i;
+            continue;
+          }
+        if (blank)
+          line += ' ';
+        blank = false;
+        if (length > 0 && is_visible(point))
+          {
+            line.append(message, i, length);
+            i += length;
+            continue;
+          }
+        for (std::size_t k = 0; k < std::max<std::size_t>(length, 1); ++k)
+          {
+            char escaped[5];
+            std::snprintf(escaped,
+                          sizeof(escaped),
+                          "\\x%02x",
+                          static_cast<unsigned char>(message[i + k]));
+            line += escaped;
+          }
+        i += std::max<std::size_t>(length, 1);
+      }
     return line;
   }
 

@@ -464,6 +464,35 @@ namespace membranes
 
   template <int dim>
   void
+  ProblemData<dim>::check_exact_solution(
+    const Triangulation<dim> &triangulation,
+    const Mapping<dim>       &mapping,
+    const Quadrature<dim>    &quadrature) const
+  {
+    if (!exact_solution_known())
+      return;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          set_gradient_step(1e-4 * cell->diameter());
+          for (const Point<dim> &unit_point : quadrature.get_points())
+            {
+              const Point<dim> p =
+                mapping.transform_unit_to_real_cell(cell, unit_point);
+              for (const auto &u : exact_u)
+                {
+                  u->value(p);
+                  u->gradient(p);
+                }
+              exact_lambda().value(p);
+            }
+        }
+  }
+
+
+
+  template <int dim>
+  void
   ProblemData<dim>::set_gradient_step(const double step) const
   {
     for (const auto &u : exact_u)

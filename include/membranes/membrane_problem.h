@@ -62,6 +62,8 @@ namespace membranes
     void
     make_grid();
     void
+    check_output_directory() const;
+    void
     create_output_directory(const std::string &directory) const;
     void
     setup_system();

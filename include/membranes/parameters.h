@@ -27,9 +27,10 @@ namespace membranes::Parameters
   };
 
   /**
-   * The message of @p error on one line: deal.II's description of its
-   * exceptions, or what(); line breaks, control characters and runs of
-   * blanks become one blank.
+   * The message of @p error on one line of printable text: deal.II's
+   * description of its exceptions, or what(); line breaks, control
+   * characters and runs of blanks become one blank, bytes that are not
+   * part of valid UTF-8 are written as \\xNN.
    */
   std::string
   one_line_message(const std::exception &error);

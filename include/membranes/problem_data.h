@@ -64,6 +64,18 @@ namespace membranes
     void
     check_boundary_data(const Triangulation<dim> &triangulation) const;
 
+    /**
+     * Evaluate the exact solution (u1, u2, their gradients, λ), when it is
+     * known, at the points of @p quadrature on every locally owned cell of
+     * @p triangulation (mapped by @p mapping): an expression that is not
+     * finite there is an InputError before anything is computed, not after
+     * the first solve, where the error norms first evaluate it.
+     */
+    void
+    check_exact_solution(const Triangulation<dim> &triangulation,
+                         const Mapping<dim>       &mapping,
+                         const Quadrature<dim>    &quadrature) const;
+
     bool
     exact_solution_known() const;
 
