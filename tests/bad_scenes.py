@@ -71,6 +71,14 @@ CASES = [
     ("Bulk parameter = 0",
      "subsection Refinement\n  set Bulk parameter = 0\nend\n", [],
      ["Refinement/Bulk parameter"]),
+    ("Balance fraction = 1",
+     "subsection Solver\n  set Stopping = balanced\n"
+     "  set Balance fraction = 1\nend\n", [], ["Solver/Balance fraction"]),
+    ("Balance fraction = 0",
+     "subsection Solver\n  set Balance fraction = 0\nend\n", [],
+     ["Solver/Balance fraction"]),
+    ("unknown Stopping",
+     "subsection Solver\n  set Stopping = early\nend\n", [], ["Stopping"]),
     ("Max dofs below the first mesh",
      "subsection Refinement\n  set Max dofs = 10\nend\n", [],
      ["Refinement/Max dofs"]),
@@ -134,6 +142,7 @@ def check_good_command_lines(membranes):
              "mu2", "Function constants", "f1", "f2", "g", "g2", "Known",
              "lambda", "u1 gradient", "u2 gradient", "Method",
              "Linear solver", "Tolerance", "Max active set iterations",
+             "Stopping", "Balance fraction",
              "Strategy", "Cycles", "Marking",
              "Bulk parameter", "Coarsen fraction", "Max dofs", "Estimator", "Directory", "Report",
              "Write vtu", "Write nodal values", "Flux reconstruction"]
