@@ -309,23 +309,31 @@ namespace membranes
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
     // condensed Laplacian; U1 moves by μ2/M and U2 by −μ1/M of the step.
-    VectorType iterate = solution;
+    // The sweeps read and write the entries of the vertices (all locally
+    // owned) in the local storage of the iterate, found once: the same
+    // arithmetic as through operator[], without a search per access.
+    VectorType                      iterate = solution;
+    const auto                     &map     = iterate.trilinos_vector().Map();
+    std::vector<std::array<int, 2>> local(vertices.size());
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      for (unsigned int i = 0; i < 2; ++i)
+        local[k][i] = map.LID(static_cast<long long>(vertices[k].dof[i]));
+    double *const values = iterate.trilinos_vector()[0];
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
         action.compute(iterate);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
             const auto  &a = vertices[k];
-            const double w = iterate[a.dof[0]] - iterate[a.dof[1]];
+            const double w = values[local[k][0]] - values[local[k][1]];
             const double r = contact_lambda(action, k) * a.dual_cell_measure;
             const double step =
               std::max(0.,
                        w - 2 * r / (data.mu_bar * a.stiffness_row_l1_norm)) -
               w;
-            iterate[a.dof[0]] += mu2 / M * step;
-            iterate[a.dof[1]] -= mu1 / M * step;
+            values[local[k][0]] += mu2 / M * step;
+            values[local[k][1]] -= mu1 / M * step;
           }
-        iterate.compress(VectorOperation::insert);
       }
     action.compute(iterate);
 
@@ -338,7 +346,7 @@ namespace membranes
         const double c =
           data.mu_bar * a.stiffness_diagonal / a.dual_cell_measure;
         const double test = (contact_lambda(action, k) -
-                             c * (iterate[a.dof[0]] - iterate[a.dof[1]])) /
+                             c * (values[local[k][0]] - values[local[k][1]])) /
                             (c * u_scale);
         const double violation = active_set.is_element(a.dof[0]) ? -test : test;
         if (violation > epsilon)
