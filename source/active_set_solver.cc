@@ -1,4 +1,6 @@
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <deal.II/base/mpi.h>
 #include <iomanip>
 #include <limits>
@@ -205,6 +207,34 @@ namespace membranes
                   locally_owned_dofs,
                   locally_relevant_dofs,
                   action);
+
+    // The constants of balanced stopping: C_F of the bounding box of the
+    // mesh, c_M of the lumped mass, and d_min.
+    std::array<double, dim> lower, upper;
+    lower.fill(std::numeric_limits<double>::max());
+    upper.fill(-std::numeric_limits<double>::max());
+    const auto &triangulation = dof_handler.get_triangulation();
+    for (unsigned int v = 0; v < triangulation.n_vertices(); ++v)
+      if (triangulation.get_used_vertices()[v])
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            lower[d] = std::min(lower[d], triangulation.get_vertices()[v][d]);
+            upper[d] = std::max(upper[d], triangulation.get_vertices()[v][d]);
+          }
+    double inverse_squares = 0;
+    for (unsigned int d = 0; d < dim; ++d)
+      inverse_squares +=
+        std::pow(Utilities::MPI::max(upper[d], mpi_communicator) -
+                   Utilities::MPI::min(lower[d], mpi_communicator),
+                 -2);
+    const double lumped_mass_constant =
+      dof_handler.get_fe().reference_cell().is_simplex() ? 2 : 3;
+    dual_norm_constant =
+      lumped_mass_constant / (numbers::PI * std::sqrt(inverse_squares));
+    double min_measure = std::numeric_limits<double>::max();
+    for (const auto &a : action.vertices())
+      min_measure = std::min(min_measure, a.dual_cell_measure);
+    min_dual_cell_measure = Utilities::MPI::min(min_measure, mpi_communicator);
   }
 
 
@@ -279,23 +309,31 @@ namespace membranes
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
     // condensed Laplacian; U1 moves by μ2/M and U2 by −μ1/M of the step.
-    VectorType iterate = solution;
+    // The sweeps read and write the entries of the vertices (all locally
+    // owned) in the local storage of the iterate, found once: the same
+    // arithmetic as through operator[], without a search per access.
+    VectorType                      iterate = solution;
+    const auto                     &map     = iterate.trilinos_vector().Map();
+    std::vector<std::array<int, 2>> local(vertices.size());
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      for (unsigned int i = 0; i < 2; ++i)
+        local[k][i] = map.LID(static_cast<long long>(vertices[k].dof[i]));
+    double *const values = iterate.trilinos_vector()[0];
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
         action.compute(iterate);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
             const auto  &a = vertices[k];
-            const double w = iterate[a.dof[0]] - iterate[a.dof[1]];
+            const double w = values[local[k][0]] - values[local[k][1]];
             const double r = contact_lambda(action, k) * a.dual_cell_measure;
             const double step =
               std::max(0.,
                        w - 2 * r / (data.mu_bar * a.stiffness_row_l1_norm)) -
               w;
-            iterate[a.dof[0]] += mu2 / M * step;
-            iterate[a.dof[1]] -= mu1 / M * step;
+            values[local[k][0]] += mu2 / M * step;
+            values[local[k][1]] -= mu1 / M * step;
           }
-        iterate.compress(VectorOperation::insert);
       }
     action.compute(iterate);
 
@@ -308,7 +346,7 @@ namespace membranes
         const double c =
           data.mu_bar * a.stiffness_diagonal / a.dual_cell_measure;
         const double test = (contact_lambda(action, k) -
-                             c * (iterate[a.dof[0]] - iterate[a.dof[1]])) /
+                             c * (values[local[k][0]] - values[local[k][1]])) /
                             (c * u_scale);
         const double violation = active_set.is_element(a.dof[0]) ? -test : test;
         if (violation > epsilon)
@@ -396,6 +434,25 @@ namespace membranes
 
   template <int dim>
   double
+  ActiveSetSolver<dim>::equilibrium_square(
+    const DiscreteAction<dim>   &action,
+    const unsigned int           k,
+    const IndexSet              &active_set,
+    const std::array<double, 3> &weights) const
+  {
+    const auto  &a  = action.vertices()[k];
+    const double d  = a.dual_cell_measure;
+    const double r1 = action.lambda_from_membrane(0, k) * d;
+    const double r2 = action.lambda_from_membrane(1, k) * d;
+    if (active_set.is_element(a.dof[0]))
+      return weights[2] * (r1 - r2) * (r1 - r2);
+    return weights[0] * r1 * r1 + weights[1] * r2 * r2;
+  }
+
+
+
+  template <int dim>
+  double
   ActiveSetSolver<dim>::kkt_residual(const DiscreteAction<dim> &action,
                                      const VectorType &ghosted_solution,
                                      const IndexSet   &active_set) const
@@ -404,14 +461,10 @@ namespace membranes
     const auto &vertices = action.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto  &a  = vertices[k];
-        const double d  = a.dual_cell_measure;
-        const double r1 = action.lambda_from_membrane(0, k) * d;
-        const double r2 = action.lambda_from_membrane(1, k) * d;
-        if (active_set.is_element(a.dof[0]))
-          equilibrium += (r1 - r2) * (r1 - r2);
-        else
-          equilibrium += r1 * r1 + r2 * r2;
+        const auto  &a = vertices[k];
+        const double d = a.dual_cell_measure;
+        equilibrium +=
+          equilibrium_square(action, k, active_set, {{1., 1., 1.}});
         const double w =
           ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]];
         const double force = action.lambda(k) * d;
@@ -432,10 +485,57 @@ namespace membranes
 
 
   template <int dim>
+  double
+  ActiveSetSolver<dim>::linearization_estimate(
+    const DiscreteAction<dim> &action,
+    const VectorType          &ghosted_solution,
+    const IndexSet            &active_set) const
+  {
+    double      energy   = 0;
+    const auto &vertices = action.vertices();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        const auto  &a    = vertices[k];
+        const double norm = a.stiffness_row_l1_norm;
+        const double step =
+          active_set.is_element(a.dof[0]) ?
+            2 * std::max(-contact_lambda(action, k), 0.) * a.dual_cell_measure /
+              (data.mu_bar * norm) :
+            std::max(ghosted_solution[a.dof[1]] - ghosted_solution[a.dof[0]],
+                     0.);
+        energy += data.mu_bar * norm * step * step;
+      }
+    return std::sqrt(Utilities::MPI::sum(energy, mpi_communicator));
+  }
+
+
+
+  template <int dim>
+  double
+  ActiveSetSolver<dim>::algebraic_estimate(const DiscreteAction<dim> &action,
+                                           const IndexSet &active_set) const
+  {
+    const double mu1 = data.mu[0], mu2 = data.mu[1];
+    double       sum      = 0;
+    const auto  &vertices = action.vertices();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      sum += equilibrium_square(action,
+                                k,
+                                active_set,
+                                {{1 / mu1, 1 / mu2, 1 / (mu1 + mu2)}}) /
+             vertices[k].dual_cell_measure;
+    return dual_norm_constant *
+           std::sqrt(Utilities::MPI::sum(sum, mpi_communicator));
+  }
+
+
+
+  template <int dim>
   typename ActiveSetSolver<dim>::Statistics
   ActiveSetSolver<dim>::solve(DiscreteAction<dim> &action,
                               VectorType          &solution,
-                              IndexSet            &active_set)
+                              IndexSet            &active_set,
+                              const double         expected_error)
   {
     Statistics statistics;
     VectorType ghosted_solution(locally_owned_dofs,
@@ -448,9 +548,21 @@ namespace membranes
     }
 
     // The forces of the last iterate set the scale of the linear solver's
-    // residual: a hundredth of what the KKT test allows.
-    const auto linear_tolerance = [&]() {
-      return 1e-2 * parameters.tolerance * action.force_scale_l2();
+    // residual: a hundredth of what the KKT test allows. Balanced stopping
+    // allows an algebraic error of γ η̃ / 2 in the energy norm.
+    const bool balanced =
+      parameters.stopping == Parameters::Stopping::balanced &&
+      expected_error > 0;
+    const double balance = parameters.balance_fraction * expected_error;
+    const auto   linear_tolerance = [&]() {
+      const double exact =
+        1e-2 * parameters.tolerance * action.force_scale_l2();
+      if (!balanced)
+        return exact;
+      return std::max(exact,
+                      balance / 2 *
+                        std::sqrt(data.mu_bar * min_dual_cell_measure) /
+                        dual_norm_constant);
     };
     system->prepare(solution, linear_tolerance(), statistics);
 
@@ -477,12 +589,28 @@ namespace membranes
         statistics.kkt_residual =
           kkt_residual(action, ghosted_solution, active_set);
         statistics.iterations = iteration;
+        if (balanced)
+          {
+            statistics.linearization_estimate =
+              linearization_estimate(action, ghosted_solution, active_set);
+            statistics.algebraic_estimate =
+              algebraic_estimate(action, active_set);
+          }
 
         pcout << "      active set iteration " << iteration << ": "
               << Utilities::MPI::sum(active_set.n_elements(), mpi_communicator)
               << " active vertices, " << n_changes
               << " to change, relative KKT residual " << statistics.kkt_residual
               << ", " << system->description() << std::endl;
+        if (balanced)
+          pcout << "      balanced stopping: linearization "
+                << *statistics.linearization_estimate << " + algebraic "
+                << *statistics.algebraic_estimate << " vs gamma * expected "
+                << balance << std::endl;
+        if (balanced && (n_changes == 0 || *statistics.linearization_estimate +
+                                               *statistics.algebraic_estimate <=
+                                             balance))
+          return statistics;
 
         const std::string reached =
           "relative KKT residual " + format(statistics.kkt_residual) +

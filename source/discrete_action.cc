@@ -141,6 +141,12 @@ namespace membranes
                                        row_l1_norm(dofs[0]) / data.mu[0]});
       }
     interior_vertex_dofs.compress();
+    const auto &map = stiffness_product.trilinos_vector().Map();
+    local_positions.resize(interior_vertices.size());
+    for (unsigned int k = 0; k < interior_vertices.size(); ++k)
+      for (unsigned int i = 0; i < 2; ++i)
+        local_positions[k][i] =
+          map.LID(static_cast<long long>(interior_vertices[k].dof[i]));
 
     for (unsigned int i = 0; i < 2; ++i)
       {
@@ -166,23 +172,28 @@ namespace membranes
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
     // μ_i ∫|∇φ_a|² |u_ih(a)|; on fine meshes it cancels down to O(h²) and
     // its rounding error is relative to that diagonal part.
-    double local_max = 0, local_sum_of_squares = 0;
+    // The vectors of the locally owned DoFs, read at local_positions.
+    const double *const products  = stiffness_product.trilinos_vector()[0];
+    const double *const loads     = load_vector.trilinos_vector()[0];
+    const double *const values    = solution.trilinos_vector()[0];
+    double              local_max = 0, local_sum_of_squares = 0;
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
       {
         const Vertex &a = interior_vertices[k];
         for (unsigned int i = 0; i < 2; ++i)
           {
-            const double stiffness = stiffness_product[a.dof[i]];
-            const double load      = load_vector[a.dof[i]];
+            const int    position  = local_positions[k][i];
+            const double stiffness = products[position];
+            const double load      = loads[position];
             const double sign      = (i == 0 ? 1. : -1.);
             lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
             stiffness_terms[i][k] = stiffness;
             load_terms[i][k]      = load;
-            const double size     = std::max({std::abs(stiffness),
-                                              std::abs(load),
-                                              data.mu[i] * a.stiffness_diagonal *
-                                                std::abs(solution[a.dof[i]])});
-            local_max             = std::max(local_max, size);
+            const double size     = std::max(
+              {std::abs(stiffness),
+                   std::abs(load),
+                   data.mu[i] * a.stiffness_diagonal * std::abs(values[position])});
+            local_max = std::max(local_max, size);
             local_sum_of_squares += size * size;
           }
       }

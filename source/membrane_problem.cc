@@ -223,15 +223,31 @@ namespace membranes
    * convergence, the last iterate is written by write_unconverged_iterate()
    * and the run ends with the solver's message, the same on every process:
    * no row is added to the report.
+   *
+   * Balanced stopping compares with the discretization error expected on
+   * this mesh, η̃ = η_prev (N_prev / N)^{1/2}: the residual estimator of the
+   * previous mesh with N_prev DoFs, decreasing at the optimal rate of P1/Q1
+   * elements in the energy norm, N^{−1/2} in two dimensions. Where the
+   * error decreases more slowly (reduced regularity, global refinement),
+   * η̃ is smaller than the error and the stopping errs on the safe side.
+   * It costs nothing in the iteration; evaluating the estimator on the
+   * iterates instead would cost one estimator (postprocessing of λ_h
+   * included) per iteration.
    */
   template <int dim>
   void
   MembraneProblem<dim>::solve()
   {
     ActiveSetStatistics statistics;
+    const double        expected_error =
+      previous_record.estimator ?
+               *previous_record.estimator *
+          std::sqrt(static_cast<double>(previous_record.dofs) / record.dofs) :
+               0.;
     try
       {
-        statistics = active_set_solver.solve(action, solution, active_set);
+        statistics =
+          active_set_solver.solve(action, solution, active_set, expected_error);
       }
     catch (const ActiveSetNotConverged &error)
       {
@@ -241,9 +257,11 @@ namespace membranes
       }
     ghosted_solution = solution;
 
-    record.active_set_iterations = statistics.iterations;
-    record.linear_iterations     = statistics.linear_iterations;
-    record.kkt_residual          = statistics.kkt_residual;
+    record.active_set_iterations  = statistics.iterations;
+    record.linear_iterations      = statistics.linear_iterations;
+    record.kkt_residual           = statistics.kkt_residual;
+    record.linearization_estimate = statistics.linearization_estimate;
+    record.algebraic_estimate     = statistics.algebraic_estimate;
     record.active_vertices =
       Utilities::MPI::sum(active_set.n_elements(), mpi_communicator);
   }
@@ -360,10 +378,12 @@ namespace membranes
 
   /**
    * The residual estimator η and its indicators η_K², when it drives
-   * adaptive refinement or the exact solution is known, and the flux
+   * adaptive refinement or a target estimator, or the exact solution is
+   * known, and the flux
    * estimator with the flux reconstruction; with the exact solution, their
    * effectivity indices η / |||e|||. The indicators of `Refinement/Estimator`
-   * are kept for marking. The time of the flux estimator counts as flux
+   * are kept for marking. Balanced stopping needs the residual estimator on
+   * every mesh. The time of the flux estimator counts as flux
    * reconstruction time, the rest as estimator time.
    */
   template <int dim>
@@ -372,6 +392,8 @@ namespace membranes
   {
     const bool adaptive = parameters.refinement.strategy ==
                           Parameters::RefinementStrategy::adaptive;
+    const bool balanced =
+      parameters.solver.stopping == Parameters::Stopping::balanced;
     const auto driving = parameters.refinement.estimator;
     indicators.reinit(0);
     for (const auto kind :
@@ -382,7 +404,7 @@ namespace membranes
           driving == kind &&
           (adaptive || parameters.refinement.target_estimator > 0);
         if (flux ? !parameters.output.flux_reconstruction :
-                   !drives && !data.exact_solution_known())
+                   !drives && !data.exact_solution_known() && !balanced)
           continue;
         TimerOutput::Scope scope(computing_timer, flux ? "flux" : "estimate");
         Vector<double>     kind_indicators;
@@ -690,6 +712,7 @@ namespace membranes
         if (cycle == 0)
           create_output_directory(parameters.output.directory);
         report.add(record);
+        previous_record = record;
         output_results(cycle);
         if (target_reached())
           break;

@@ -740,6 +740,19 @@ namespace membranes::Parameters
                       Integer(1, 100000),
                       "The run stops with an error if the active set method "
                       "has not converged after this many iterations.");
+    prm.declare_entry("Stopping",
+                      "exact",
+                      Selection("exact|balanced"),
+                      "exact: the active set method stops at Tolerance; "
+                      "balanced: it and its CG solves stop once the "
+                      "linearization and algebraic errors are below Balance "
+                      "fraction times the discretization error expected on "
+                      "the mesh (the residual estimator of the previous mesh "
+                      "scaled to this one; the first mesh stops exactly).");
+    prm.declare_entry("Balance fraction",
+                      "0.1",
+                      Double(),
+                      "gamma in (0, 1) of Stopping = balanced.");
     prm.leave_subsection();
   }
 
@@ -757,6 +770,13 @@ namespace membranes::Parameters
                                                   LinearSolverType::automatic);
     tolerance                 = get_double(prm, "Solver", "Tolerance");
     max_active_set_iterations = prm.get_integer("Max active set iterations");
+    stopping         = (prm.get("Stopping") == "balanced" ? Stopping::balanced :
+                                                            Stopping::exact);
+    balance_fraction = get_double(prm, "Solver", "Balance fraction");
+    if (!(balance_fraction > 0 && balance_fraction < 1))
+      throw invalid_entry("Solver/Balance fraction",
+                          prm.get("Balance fraction"),
+                          "the fraction must be in (0, 1)");
     prm.leave_subsection();
   }
 

@@ -48,7 +48,9 @@ namespace membranes
               r.time_flux,
               r.levels,
               r.processes,
-              r.memory_mb};
+              r.memory_mb,
+              r.linearization_estimate,
+              r.algebraic_estimate};
     }
 
     /** Columns that hold whole numbers. */
@@ -103,7 +105,9 @@ namespace membranes
                                                 "time_flux_s",
                                                 "levels",
                                                 "processes",
-                                                "memory_mb"};
+                                                "memory_mb",
+                                                "eta_linearization",
+                                                "eta_algebraic"};
     return names;
   }
 

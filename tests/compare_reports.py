@@ -5,7 +5,7 @@ report.csv files, or the nodal-values-NN.csv files of two runs.
 Usage::
 
     compare_reports.py a.csv b.csv --columns c1,c2,... --rtol R [--atol A]
-                       [--scale value|column]
+                       [--scale value|column] [--one-sided]
 
 The files must have the same number of data rows, and for every named column
 and every row the two values must satisfy
@@ -18,7 +18,10 @@ to the max norm, the right measure for nodal values that pass through zero).
 With ``--rtol 0`` (and no ``--atol``) the values must be equal, which is
 the right test for integer columns such as ``dofs`` or ``active_vertices``.
 Two empty fields agree; an empty field never agrees with a number; NaN never
-agrees with anything.  Columns are looked up by name in each file's header.
+agrees with anything.  With ``--one-sided`` only b - a is bounded so
+(b <= a always agrees): b costs or errs at most that much more than a, e.g.
+``--rtol 0 --one-sided`` on an iteration count says b <= a.  Columns are
+looked up by name in each file's header.
 
 One line ``PASS ...`` or ``FAIL ...`` is printed for the row count and for
 each column, giving the largest difference found and the tolerance.  Exit
@@ -46,12 +49,13 @@ def fmt(value):
     return "empty" if value is None else f"{value:.6g}"
 
 
-def values_agree(a, b, rtol, atol, scale):
+def values_agree(a, b, rtol, atol, scale, one_sided=False):
     """Whether two parsed fields agree within the tolerance; ``scale`` is
-    S of the module docstring, or None for max(|a|, |b|)."""
+    S of the module docstring, or None for max(|a|, |b|); ``one_sided``:
+    b <= a always agrees."""
     if a is None or b is None:
         return a is None and b is None
-    if a == b:  # also covers equal infinities
+    if a == b or (one_sided and b < a):  # also covers equal infinities
         return True
     if scale is None:
         scale = max(abs(a), abs(b))
@@ -74,7 +78,8 @@ def column_scale(values):
     return max((abs(v) for v in values if v is not None), default=0.0)
 
 
-def compare_column(column, first, second, rtol, atol, scale_by_column):
+def compare_column(column, first, second, rtol, atol, scale_by_column,
+                   one_sided=False):
     """Compare one column; return (passed, message)."""
     (path_a, rows_a), (path_b, rows_b) = first, second
     pairs = [(record_a[column], record_b[column])
@@ -90,7 +95,7 @@ def compare_column(column, first, second, rtol, atol, scale_by_column):
         diff = differences(a, b, scale)
         if diff is not None:
             largest = [max(old, new) for old, new in zip(largest, diff)]
-        if not values_agree(a, b, rtol, atol, scale):
+        if not values_agree(a, b, rtol, atol, scale, one_sided):
             mismatches.append(f"row {row}: {text_a or 'empty'} vs "
                               f"{text_b or 'empty'}")
     relative_to = ("" if scale is None else
@@ -142,6 +147,8 @@ def parse_arguments(argv):
                         default="value",
                         help="relative to max(|a|, |b|) of each row (value) "
                         "or of the whole column (column)")
+    parser.add_argument("--one-sided", action="store_true",
+                        help="bound only b - a: b <= a always agrees")
     return parser.parse_args(argv)
 
 
@@ -170,7 +177,7 @@ def compare(arguments):
             passed, message = compare_column(
                 column, (arguments.first, rows_a),
                 (arguments.second, rows_b), arguments.rtol, arguments.atol,
-                arguments.scale == "column")
+                arguments.scale == "column", arguments.one_sided)
         except ReportError as error:
             passed, message = False, str(error)
         verdicts.append(report_line(passed, column, message))

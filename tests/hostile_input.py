@@ -247,7 +247,8 @@ TYPED_ENTRIES = [
     "Geometry/Domain", "Geometry/Cell type", "Geometry/Initial refinement",
     "Problem/mu1", "Problem/mu2", "Exact solution/Known", "Solver/Method",
     "Solver/Linear solver", "Solver/Tolerance",
-    "Solver/Max active set iterations", "Refinement/Strategy",
+    "Solver/Max active set iterations", "Solver/Stopping",
+    "Solver/Balance fraction", "Refinement/Strategy",
     "Refinement/Cycles", "Refinement/Marking", "Refinement/Bulk parameter",
     "Refinement/Coarsen fraction", "Refinement/Max dofs",
     "Refinement/Estimator", "Output/Report", "Output/Write vtu",
@@ -260,6 +261,7 @@ NUMBERS = ["1e308", "1e-308", "-0", "1e400", "nan", "2.5"]
 NUMERIC_ENTRIES = {
     "Problem/mu1": {"2.5"},
     "Solver/Tolerance": set(),
+    "Solver/Balance fraction": set(),
     "Refinement/Bulk parameter": set(),
     "Geometry/Initial refinement": {"-0"},
     "Refinement/Cycles": set(),

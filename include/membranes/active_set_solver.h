@@ -1,6 +1,7 @@
 #ifndef membranes_active_set_solver_h
 #define membranes_active_set_solver_h
 
+#include <array>
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
@@ -228,6 +229,52 @@ namespace membranes
    * `Max active set iterations`, solve() throws ActiveSetNotConverged with
    * the residual reached. Cycling is detected and remedied by
    * ActiveSetHistory.
+   *
+   * <b>Balanced stopping</b> (`Solver/Stopping = balanced`). On a mesh whose
+   * discretization error η̃ in the energy norm |||v|||² = Σ_i μ_i |v_i|²_{H1}
+   * is expected, the method stops as the adaptive inexact semismooth Newton
+   * method of Dabaghi, Martin and Vohralík (SIAM J. Sci. Comput. 42, 2020):
+   * once the linearization and algebraic errors of the iterate are below
+   * the fraction γ = `Balance fraction` of η̃,
+   *
+   *   η_lin + η_alg ≤ γ η̃,
+   *
+   * or once the active set has settled; and each linear solve stops once
+   * its algebraic error is below γ η̃ / 2. Iterations beyond that improve
+   * the discrete solution by less than the mesh can resolve. Both measures
+   * are in the units of the energy norm (of the estimator):
+   * - η_alg bounds the energy norm of the error left by the linear
+   *   solver, sup ρ(v) / |||v||| for the residual ρ of the equilibrium
+   *   part of the KKT conditions (ρ_ia = λ_ia d_a of membrane i on inactive
+   *   vertices, ρ_a = (λ_1a − λ_2a) d_a of both on active ones). With the
+   *   lumped mass d_a, |ρ(v)| ≤ (Σ ρ²/(m d))^{1/2} (Σ_i μ_i Σ_a d_a
+   * v_ia²)^{1/2} (m = μ_i, or μ1 + μ2 on active vertices), the lumped L² norm
+   * is at most c_M times the L² norm (c_M = 2 on triangles, 3 on
+   *   quadrilaterals: the eigenvalues of the element mass matrices), and
+   *   ‖v‖ ≤ C_F |v|_{H1} (Friedrichs; C_F = 1/(π (1/a² + 1/b²)^{1/2}), the
+   *   constant of the bounding box a × b of the mesh, which contains ω), so
+   *     η_alg = c_M C_F (Σ_a Σ_i ρ_ia² / (m_ia d_a))^{1/2}.
+   *   The same bound with d_a ≥ d_min and m ≥ μ̄ turns γ η̃ / 2 into the
+   *   Euclidean residual norm at which CG stops,
+   *   γ η̃ (μ̄ d_min)^{1/2} / (2 c_M C_F) (never below the tolerance of exact
+   *   stopping), for the coupled system and for S and W of the decoupled
+   *   one (their errors add up as |||e|||² = |e_S|²/(μ1 + μ2) + μ̄ |e_W|²).
+   *   The bound is sharp for smooth residuals and pessimistic, by up to
+   *   1/h, for oscillating ones: the CG tolerance errs on the safe side.
+   * - η_lin measures how far the active set is from the right one: the
+   *   energy norm of one sweep of the projected Jacobi relaxation of the
+   *   prediction below, the correction δ of w that the wanted changes ask
+   *   for: δ_a = −W_a on an inactive vertex with W_a < 0, and
+   *   δ_a = 2 λ_a⁻ d_a / (μ̄ ‖A_a‖₁) on an active one with λ_a < 0. Moving w by
+   *   δ with s fixed moves (u1, u2) by (μ2 δ, −μ1 δ)/(μ1 + μ2), of energy
+   *   μ̄ δᵀAδ ≤ μ̄ Σ_a ‖A_a‖₁ δ_a² (diag(‖A_a‖₁) − A is positive
+   *   semidefinite), so
+   *     η_lin = (μ̄ Σ_a ‖A_a‖₁ δ_a²)^{1/2},
+   *   local to the vertices that want to change (an estimate of the next
+   *   step, not a bound of the whole linearization error: the next solve
+   *   spreads the correction).
+   * On the first mesh nothing is expected (η̃ = 0 is passed) and the method
+   * stops exactly. With `exact` (the default) nothing of this is evaluated.
    */
   template <int dim>
   class ActiveSetSolver
@@ -259,12 +306,14 @@ namespace membranes
      * owned entries) and the initial active set @p active_set (u1 DoFs of
      * active vertices). On return both hold the converged iterate, and
      * @p action holds λ_a for it; if ActiveSetNotConverged is thrown, the
-     * last iterate.
+     * last iterate. @p expected_error is the discretization error η̃
+     * expected on this mesh for balanced stopping, 0 if none is known.
      */
     Statistics
     solve(DiscreteAction<dim> &action,
           VectorType          &solution,
-          IndexSet            &active_set);
+          IndexSet            &active_set,
+          const double         expected_error = 0);
 
     /**
      * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
@@ -364,6 +413,32 @@ namespace membranes
                    const VectorType          &ghosted_solution,
                    const IndexSet            &active_set) const;
 
+    /**
+     * The squared residual of the equilibrium part of the KKT conditions at
+     * the k-th vertex of @p action, weighted: with r_ia = λ_ia d_a,
+     * @p weights[0] r_1a² + @p weights[1] r_2a² on an inactive vertex,
+     * @p weights[2] (r_1a − r_2a)² on an active one.
+     */
+    double
+    equilibrium_square(const DiscreteAction<dim>   &action,
+                       const unsigned int           k,
+                       const IndexSet              &active_set,
+                       const std::array<double, 3> &weights) const;
+
+    /**
+     * η_lin of an iterate with λ_a in @p action (see the class
+     * documentation), over all processes.
+     */
+    double
+    linearization_estimate(const DiscreteAction<dim> &action,
+                           const VectorType          &ghosted_solution,
+                           const IndexSet            &active_set) const;
+
+    /** η_alg of an iterate with λ_a in @p action, over all processes. */
+    double
+    algebraic_estimate(const DiscreteAction<dim> &action,
+                       const IndexSet            &active_set) const;
+
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
     const ConditionalOStream &pcout;
@@ -379,6 +454,14 @@ namespace membranes
 
     /** The active sets visited on the current mesh. */
     ActiveSetHistory history;
+
+    /**
+     * c_M C_F of balanced stopping: the Friedrichs constant of the bounding
+     * box of the mesh times that of the lumped mass (class documentation).
+     */
+    double dual_norm_constant;
+    /** d_min, the smallest d_a of the mesh (over all processes). */
+    double min_dual_cell_measure;
   };
 } // namespace membranes
 

@@ -14,6 +14,7 @@
 #include <membranes/linear_solver.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
+#include <optional>
 #include <string>
 
 namespace membranes
@@ -26,6 +27,11 @@ namespace membranes
     unsigned int iterations        = 0; ///< Active set iterations.
     unsigned int linear_iterations = 0; ///< CG iterations, summed.
     double       kkt_residual      = 0; ///< Relative KKT residual at the end.
+    /**
+     * With balanced stopping: the estimates η_lin and η_alg of
+     * ActiveSetSolver at the end, in the energy norm.
+     */
+    std::optional<double> linearization_estimate, algebraic_estimate;
   };
 
 

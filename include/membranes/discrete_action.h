@@ -196,7 +196,13 @@ namespace membranes
     /** The product of stiffness_matrix with the last solution. */
     VectorType stiffness_product;
 
-    std::vector<Vertex>                                 interior_vertices;
+    std::vector<Vertex> interior_vertices;
+    /**
+     * The positions of the DoFs (u1, u2) of interior_vertices in the local
+     * storage of vectors of the locally owned DoFs (all of them share one
+     * layout), so that compute() reads them without a search per entry.
+     */
+    std::vector<std::array<int, 2>>                     local_positions;
     std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
     IndexSet                                            interior_vertex_dofs;
     std::array<std::vector<double>, 2>                  lambda_i;

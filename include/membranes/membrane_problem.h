@@ -139,6 +139,8 @@ namespace membranes
 
     /** The row of the current cycle. */
     CycleRecord record;
+    /** The previous row, for the error expected on the next mesh. */
+    CycleRecord previous_record;
   };
 } // namespace membranes
 

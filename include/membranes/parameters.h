@@ -167,6 +167,13 @@ namespace membranes::Parameters
     cg_amg
   };
 
+  /** When the active set method and its linear solves stop. */
+  enum class Stopping
+  {
+    exact,   ///< At `Tolerance`: the discrete solution to round-off.
+    balanced ///< At a fraction of the discretization error of the mesh.
+  };
+
   /** Subsection `Solver`: the primal-dual active set method (SPEC §2.2). */
   struct Solver
   {
@@ -176,6 +183,9 @@ namespace membranes::Parameters
                  linear_solver; ///< UMFPACK, CG with AMG, or chosen by size.
     double       tolerance;     ///< Relative KKT residual to reach.
     unsigned int max_active_set_iterations; ///< Give up after this many.
+    Stopping     stopping; ///< Exact, or balanced against the estimator.
+    /** γ: linearization + algebraic error ≤ γ η (balanced stopping). */
+    double balance_fraction;
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -52,6 +52,11 @@ namespace membranes
 
     /** Relative KKT residual of the active set solver at the end. */
     double kkt_residual = 0;
+    /**
+     * η_lin and η_alg of balanced stopping at the end (ActiveSetSolver);
+     * empty with exact stopping and on the first mesh.
+     */
+    std::optional<double> linearization_estimate, algebraic_estimate;
     /** min_a (u1h − u2h)(a) and min_a λ_a over V_h. */
     double min_w = 0, min_lambda = 0;
     /** max_a |λ_1a − λ_2a| d_a / F, F the force scale of (4.5) (Prop. 12). */
