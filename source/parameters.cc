@@ -543,13 +543,83 @@ namespace membranes::Parameters
 
 
 
+  namespace
+  {
+    /**
+     * The words of a `Selection` entry and the values they stand for: the
+     * one mapping between a scene and the program, from which the entry's
+     * pattern is declared (selection()) and its value read (selected()).
+     */
+    template <typename Enum>
+    using Choices = std::vector<std::pair<std::string, Enum>>;
+
+    const Choices<Domain>           domains{{"square", Domain::square},
+                                  {"lshape", Domain::lshape},
+                                  {"slit", Domain::slit},
+                                  {"disk", Domain::disk},
+                                  {"file", Domain::file}};
+    const Choices<CellType>         cell_types{{"quadrilateral",
+                                                CellType::quadrilateral},
+                                       {"triangle", CellType::triangle}};
+    const Choices<SolverMethod>     methods{{"auto", SolverMethod::automatic},
+                                        {"coupled", SolverMethod::coupled},
+                                        {"decoupled", SolverMethod::decoupled}};
+    const Choices<LinearSolverType> linear_solvers{
+      {"auto", LinearSolverType::automatic},
+      {"direct", LinearSolverType::direct},
+      {"cg-amg", LinearSolverType::cg_amg}};
+    const Choices<Stopping>           stoppings{{"exact", Stopping::exact},
+                                      {"balanced", Stopping::balanced}};
+    const Choices<RefinementStrategy> strategies{
+      {"global", RefinementStrategy::global},
+      {"adaptive", RefinementStrategy::adaptive}};
+    const Choices<Marking>   markings{{"bulk", Marking::bulk},
+                                    {"fixed fraction",
+                                       Marking::fixed_fraction}};
+    const Choices<Estimator> estimators{{"residual", Estimator::residual},
+                                        {"flux", Estimator::flux}};
+
+    /** The Selection pattern of @p choices: their words, in this order. */
+    template <typename Enum>
+    Selection
+    selection(const Choices<Enum> &choices)
+    {
+      std::string words;
+      for (const auto &choice : choices)
+        words += (words.empty() ? "" : "|") + choice.first;
+      return Selection(words);
+    }
+
+    /**
+     * The value of the Selection entry @p entry of the current subsection;
+     * its pattern, selection(@p choices), admits no other word.
+     */
+    template <typename Enum>
+    Enum
+    selected(const ParameterHandler &prm,
+             const std::string      &entry,
+             const Choices<Enum>    &choices)
+    {
+      const std::string word = prm.get(entry);
+      for (const auto &[name, value] : choices)
+        if (name == word)
+          return value;
+      AssertThrow(false,
+                  dealii::ExcMessage("'" + word + "' is not a word of " +
+                                     entry));
+      return choices.front().second;
+    }
+  } // namespace
+
+
+
   void
   Geometry::declare_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Geometry");
     prm.declare_entry("Domain",
                       "square",
-                      Selection("square|lshape|slit|disk|file"),
+                      selection(domains),
                       "square = (-1,1)^2; lshape = (-1,1)^2 minus [0,1)^2; "
                       "slit = (-1,1)^2 minus the segment [0,1) x {0} (both "
                       "faces of the slit are boundary); disk = unit disk "
@@ -562,7 +632,7 @@ namespace membranes::Parameters
                       "when Domain = file.");
     prm.declare_entry("Cell type",
                       "quadrilateral",
-                      Selection("quadrilateral|triangle"),
+                      selection(cell_types),
                       "quadrilateral: Q1 elements; triangle: P1 elements (the "
                       "paper's setting). Quadrilateral meshes are split into "
                       "triangles when triangle is asked for.");
@@ -577,19 +647,13 @@ namespace membranes::Parameters
   Geometry::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Geometry");
-    const std::string d = prm.get("Domain");
-    domain              = (d == "square" ? Domain::square :
-                           d == "lshape" ? Domain::lshape :
-                           d == "slit"   ? Domain::slit :
-                           d == "disk"   ? Domain::disk :
-                                           Domain::file);
-    mesh_file           = prm.get("Mesh file");
+    domain    = selected(prm, "Domain", domains);
+    mesh_file = prm.get("Mesh file");
     if (domain == Domain::file && mesh_file.empty())
       throw invalid_entry("Geometry/Mesh file",
                           mesh_file,
                           "a Gmsh .msh file is needed when Domain = file");
-    cell_type = (prm.get("Cell type") == "triangle" ? CellType::triangle :
-                                                      CellType::quadrilateral);
+    cell_type          = selected(prm, "Cell type", cell_types);
     initial_refinement = prm.get_integer("Initial refinement");
     prm.leave_subsection();
   }
@@ -718,7 +782,7 @@ namespace membranes::Parameters
     prm.enter_subsection("Solver");
     prm.declare_entry("Method",
                       "auto",
-                      Selection("auto|coupled|decoupled"),
+                      selection(methods),
                       "coupled: active set method on (u1, u2); decoupled: "
                       "linear problem for s = mu1 u1 + mu2 u2 and obstacle "
                       "problem for w = u1 - u2; auto: the faster of the two "
@@ -727,7 +791,7 @@ namespace membranes::Parameters
                       "discrete solution.");
     prm.declare_entry("Linear solver",
                       "auto",
-                      Selection("auto|direct|cg-amg"),
+                      selection(linear_solvers),
                       "direct: UMFPACK; cg-amg: CG with Trilinos ML AMG; "
                       "auto: direct for small problems on one process.");
     prm.declare_entry("Tolerance",
@@ -742,7 +806,7 @@ namespace membranes::Parameters
                       "has not converged after this many iterations.");
     prm.declare_entry("Stopping",
                       "exact",
-                      Selection("exact|balanced"),
+                      selection(stoppings),
                       "exact: the active set method stops at Tolerance; "
                       "balanced: it and its CG solves stop once the "
                       "linearization and algebraic errors are below Balance "
@@ -760,19 +824,12 @@ namespace membranes::Parameters
   Solver::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Solver");
-    const std::string m       = prm.get("Method");
-    method                    = (m == "coupled"   ? SolverMethod::coupled :
-                                 m == "decoupled" ? SolverMethod::decoupled :
-                                                    SolverMethod::automatic);
-    const std::string ls      = prm.get("Linear solver");
-    linear_solver             = (ls == "direct" ? LinearSolverType::direct :
-                                 ls == "cg-amg" ? LinearSolverType::cg_amg :
-                                                  LinearSolverType::automatic);
+    method                    = selected(prm, "Method", methods);
+    linear_solver             = selected(prm, "Linear solver", linear_solvers);
     tolerance                 = get_double(prm, "Solver", "Tolerance");
     max_active_set_iterations = prm.get_integer("Max active set iterations");
-    stopping         = (prm.get("Stopping") == "balanced" ? Stopping::balanced :
-                                                            Stopping::exact);
-    balance_fraction = get_double(prm, "Solver", "Balance fraction");
+    stopping                  = selected(prm, "Stopping", stoppings);
+    balance_fraction          = get_double(prm, "Solver", "Balance fraction");
     if (!(balance_fraction > 0 && balance_fraction < 1))
       throw invalid_entry("Solver/Balance fraction",
                           prm.get("Balance fraction"),
@@ -788,7 +845,7 @@ namespace membranes::Parameters
     prm.enter_subsection("Refinement");
     prm.declare_entry("Strategy",
                       "global",
-                      Selection("global|adaptive"),
+                      selection(strategies),
                       "global: every cell is refined in every cycle; "
                       "adaptive: cells are marked by the residual "
                       "estimator.");
@@ -798,7 +855,7 @@ namespace membranes::Parameters
                       "Number of meshes (cycles) of the run.");
     prm.declare_entry("Marking",
                       "bulk",
-                      Selection("bulk|fixed fraction"),
+                      selection(markings),
                       "Marking for adaptive refinement: bulk (Doerfler) "
                       "refines the fewest cells that hold the share 'Bulk "
                       "parameter' of the squared estimator; fixed fraction "
@@ -831,7 +888,7 @@ namespace membranes::Parameters
                       "0 = no limit.");
     prm.declare_entry("Estimator",
                       "residual",
-                      Selection("residual|flux"),
+                      selection(estimators),
                       "A posteriori estimator that drives adaptive "
                       "refinement: residual, or flux (built on the flux "
                       "reconstruction t_ih; needs 'Output/Flux "
@@ -854,12 +911,9 @@ namespace membranes::Parameters
   Refinement::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    strategy =
-      (prm.get("Strategy") == "adaptive" ? RefinementStrategy::adaptive :
-                                           RefinementStrategy::global);
-    cycles = prm.get_integer("Cycles");
-    marking =
-      (prm.get("Marking") == "bulk" ? Marking::bulk : Marking::fixed_fraction);
+    strategy       = selected(prm, "Strategy", strategies);
+    cycles         = prm.get_integer("Cycles");
+    marking        = selected(prm, "Marking", markings);
     bulk_parameter = get_double(prm, "Refinement", "Bulk parameter");
     if (!(bulk_parameter > 0))
       throw invalid_entry("Refinement/Bulk parameter",
@@ -871,10 +925,9 @@ namespace membranes::Parameters
       throw invalid_entry("Refinement/Coarsen fraction",
                           prm.get("Coarsen fraction"),
                           "Bulk parameter + Coarsen fraction must be <= 1");
-    minimum_growth = get_double(prm, "Refinement", "Minimum growth");
-    max_dofs       = prm.get_integer("Max dofs");
-    estimator =
-      (prm.get("Estimator") == "flux" ? Estimator::flux : Estimator::residual);
+    minimum_growth   = get_double(prm, "Refinement", "Minimum growth");
+    max_dofs         = prm.get_integer("Max dofs");
+    estimator        = selected(prm, "Estimator", estimators);
     target_estimator = get_double(prm, "Refinement", "Target estimator");
     prm.leave_subsection();
   }
