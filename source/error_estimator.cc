@@ -19,26 +19,14 @@ namespace membranes
 
   template <int dim>
   double
-  ErrorEstimator<dim>::estimate(
-    const Parameters::Estimator    kind,
-    const DoFHandler<dim>         &dof_handler,
-    const VectorType              &ghosted_solution,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    Vector<double>                &indicators,
-    const MPI_Comm                 mpi_communicator) const
+  ErrorEstimator<dim>::residual_estimate(const DoFHandler<dim> &dof_handler,
+                                         const VectorType &ghosted_solution,
+                                         const DiscreteAction<dim> &action,
+                                         Vector<double>            &indicators,
+                                         const MPI_Comm mpi_communicator) const
   {
-    if (kind == Parameters::Estimator::flux)
-      return flux_estimate(dof_handler,
-                           ghosted_solution,
-                           flux_reconstruction,
-                           indicators,
-                           mpi_communicator);
-
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    add_cell_terms(dof_handler,
-                   ghosted_solution,
-                   flux_reconstruction,
-                   indicators);
+    add_cell_terms(dof_handler, ghosted_solution, action, indicators);
     add_jump_terms(dof_handler, ghosted_solution, indicators);
 
     double local_sum = 0;
@@ -54,11 +42,10 @@ namespace membranes
 
   template <int dim>
   void
-  ErrorEstimator<dim>::add_cell_terms(
-    const DoFHandler<dim>         &dof_handler,
-    const VectorType              &ghosted_solution,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    Vector<double>                &indicators) const
+  ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
+                                      const VectorType      &ghosted_solution,
+                                      const DiscreteAction<dim> &action,
+                                      Vector<double> &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
@@ -66,7 +53,7 @@ namespace membranes
     const bool    with_laplacians = !fe.reference_cell().is_simplex();
     FEValues<dim> fe_values(*discretization.mapping,
                             fe,
-                            flux_reconstruction.dual_quadrature().quadrature(),
+                            action.dual_quadrature().quadrature(),
                             update_values | update_JxW_values |
                               (with_laplacians ? update_hessians :
                                                  update_default));
@@ -92,7 +79,7 @@ namespace membranes
         {
           fe_values.reinit(cell);
           load_values.reinit(cell);
-          flux_reconstruction.lambda_h_values(cell, lambda);
+          action.lambda_h_values(cell, lambda);
 
           const double h_K     = cell->diameter();
           double       eta2    = 0;
@@ -274,22 +261,23 @@ namespace membranes
 
 
   template <int dim>
-  double
+  typename ErrorEstimator<dim>::FluxEstimate
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>         &dof_handler,
     const VectorType              &ghosted_solution,
+    const DiscreteAction<dim>     &action,
     const FluxReconstruction<dim> &flux_reconstruction,
     Vector<double>                &indicators,
     const MPI_Comm                 mpi_communicator) const
   {
-    const auto &quadrature = flux_reconstruction.dual_quadrature().quadrature();
-    FEValues<dim>                      fe_values(*discretization.mapping,
+    const auto        &quadrature = action.dual_quadrature().quadrature();
+    FEValues<dim>      fe_values(*discretization.mapping,
                             *discretization.fe,
                             quadrature,
                             update_values | update_gradients |
                               update_jacobians | update_JxW_values);
-    const unsigned int                 n_q_points = quadrature.size();
-    std::array<std::vector<double>, 2> u;
+    const unsigned int n_q_points = quadrature.size();
+    std::array<std::vector<double>, 2>         u;
     std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
     std::vector<Tensor<1, dim>>                flux;
     std::vector<double>                        divergence, lambda;
@@ -307,7 +295,7 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          flux_reconstruction.nodal_lambda_values(fe_values, lambda);
+          action.nodal_lambda_values(fe_values, lambda);
           const double h_K  = cell->diameter();
           double       eta2 = 0;
           for (unsigned int i = 0; i < 2; ++i)
@@ -345,10 +333,15 @@ namespace membranes
 
     for (double &sum : sums)
       sum = Utilities::MPI::sum(sum, mpi_communicator);
-    double eta2 = 2 * sums[4];
+    FluxEstimate estimate;
+    double       eta2 = 2 * sums[4];
     for (unsigned int i = 0; i < 2; ++i)
       eta2 += std::pow(std::sqrt(sums[2 * i]) + std::sqrt(sums[2 * i + 1]), 2);
-    return std::sqrt(eta2);
+    estimate.eta         = std::sqrt(eta2);
+    estimate.flux        = std::sqrt(sums[0] + sums[2]);
+    estimate.oscillation = std::sqrt(sums[1] + sums[3]);
+    estimate.contact     = std::sqrt(2 * sums[4]);
+    return estimate;
   }
 
 

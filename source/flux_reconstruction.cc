@@ -12,109 +12,6 @@
 
 namespace membranes
 {
-  template <int dim>
-  DualCellQuadrature<dim>::DualCellQuadrature(
-    const ReferenceCell &reference_cell,
-    const unsigned int   degree)
-  {
-    static_assert(dim == 2, "The dual mesh is implemented for dim = 2.");
-    const unsigned int n_vertices = reference_cell.n_vertices();
-
-    std::vector<Point<dim>> vertices(n_vertices);
-    Point<dim>              barycentre;
-    for (unsigned int v = 0; v < n_vertices; ++v)
-      {
-        vertices[v] = reference_cell.template vertex<dim>(v);
-        barycentre += vertices[v] / n_vertices;
-      }
-
-    // Every edge (face in 2d) of the reference cell contributes the
-    // triangles (a, m_e, b) for both of its end points a.
-    for (const unsigned int e : reference_cell.face_indices())
-      for (unsigned int end = 0; end < 2; ++end)
-        {
-          const unsigned int a =
-            reference_cell.face_to_cell_vertices(e, end, 1);
-          const unsigned int other =
-            reference_cell.face_to_cell_vertices(e, 1 - end, 1);
-          SubTriangle triangle;
-          triangle.vertex  = a;
-          triangle.face    = e;
-          triangle.corners = {
-            {vertices[a], (vertices[a] + vertices[other]) / 2, barycentre}};
-          const Tensor<1, dim> edge_1 = triangle.corners[1] - vertices[a];
-          const Tensor<1, dim> edge_2 = triangle.corners[2] - vertices[a];
-          triangle.area =
-            std::abs(edge_1[0] * edge_2[1] - edge_1[1] * edge_2[0]) / 2;
-          for (unsigned int j = 0; j < 3; ++j)
-            {
-              const Point<dim> &p      = triangle.corners[(j + 1) % 3];
-              const Point<dim> &q      = triangle.corners[(j + 2) % 3];
-              Tensor<1, dim>    normal = cross_product_2d(q - p);
-              normal /= normal.norm();
-              if (normal * (p - triangle.corners[j]) < 0)
-                normal *= -1;
-              triangle.normals[j] = normal;
-            }
-          triangles.push_back(triangle);
-        }
-
-    const QGaussSimplex<dim> simplex_rule((degree + 2) / 2);
-    std::vector<Point<dim>>  points;
-    std::vector<double>      weights;
-    for (unsigned int s = 0; s < triangles.size(); ++s)
-      {
-        const auto &corners = triangles[s].corners;
-        for (unsigned int q = 0; q < simplex_rule.size(); ++q)
-          {
-            const Point<dim> &xi = simplex_rule.point(q);
-            points.push_back(corners[0] + xi[0] * (corners[1] - corners[0]) +
-                             xi[1] * (corners[2] - corners[0]));
-            weights.push_back(simplex_rule.weight(q) * 2 * triangles[s].area);
-            triangle_of_points.push_back(s);
-          }
-      }
-    rule = Quadrature<dim>(points, weights);
-  }
-
-
-
-  template <int dim>
-  const Quadrature<dim> &
-  DualCellQuadrature<dim>::quadrature() const
-  {
-    return rule;
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  DualCellQuadrature<dim>::vertex_of_point(const unsigned int q) const
-  {
-    return triangles[triangle_of_points[q]].vertex;
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  DualCellQuadrature<dim>::sub_triangle_of_point(const unsigned int q) const
-  {
-    return triangle_of_points[q];
-  }
-
-
-
-  template <int dim>
-  const std::vector<typename DualCellQuadrature<dim>::SubTriangle> &
-  DualCellQuadrature<dim>::sub_triangles() const
-  {
-    return triangles;
-  }
-
-
-
   namespace
   {
     /**
@@ -352,11 +249,12 @@ namespace membranes
   template <int dim>
   FluxReconstruction<dim>::FluxReconstruction(
     const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data)
+    const ProblemData<dim>    &data,
+    const DiscreteAction<dim> &action)
     : discretization(discretization)
     , data(data)
-    , dual_cell_quadrature(discretization.fe->reference_cell(), 2)
-    , lambda_h(nullptr)
+    , action(action)
+    , dual_cell_quadrature(action.dual_quadrature())
   {
     // The hat functions of the cell's vertices at the Gauss points of the
     // edges of the sub-triangles (reference values).
@@ -398,82 +296,6 @@ namespace membranes
 
 
   template <int dim>
-  const DualCellQuadrature<dim> &
-  FluxReconstruction<dim>::dual_quadrature() const
-  {
-    return dual_cell_quadrature;
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::set_lambda_h(const DoFHandler<dim> &dof_handler,
-                                        const VectorType      &lambda_h,
-                                        const IndexSet &dual_mesh_vertices)
-  {
-    this->dof_handler        = &dof_handler;
-    this->lambda_h           = &lambda_h;
-    this->dual_mesh_vertices = dual_mesh_vertices;
-  }
-
-
-
-  template <int dim>
-  double
-  FluxReconstruction<dim>::lambda_h_value(const CellIterator &cell,
-                                          const unsigned int  v) const
-  {
-    const types::global_dof_index a = cell->vertex_dof_index(v, 0);
-    return dual_mesh_vertices.is_element(a) ? (*lambda_h)[a] : 0.;
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::lambda_h_values(const CellIterator  &cell,
-                                           std::vector<double> &values,
-                                           std::vector<bool> *in_omega_h) const
-  {
-    // λ_h is constant on the pieces of each vertex: look it up once per
-    // vertex, not once per point.
-    std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
-    std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
-    for (const unsigned int v : cell->vertex_indices())
-      {
-        vertex_values[v] = lambda_h_value(cell, v);
-        vertex_in_omega_h[v] =
-          dual_mesh_vertices.is_element(cell->vertex_dof_index(v, 0));
-      }
-    values.resize(dual_cell_quadrature.quadrature().size());
-    if (in_omega_h)
-      in_omega_h->resize(values.size());
-    for (unsigned int q = 0; q < values.size(); ++q)
-      {
-        const unsigned int v = dual_cell_quadrature.vertex_of_point(q);
-        values[q]            = vertex_values[v];
-        if (in_omega_h)
-          (*in_omega_h)[q] = vertex_in_omega_h[v];
-      }
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::nodal_lambda_values(
-    const FEValues<dim> &fe_values,
-    std::vector<double> &values) const
-  {
-    values.resize(fe_values.n_quadrature_points);
-    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(*lambda_h,
-                                                                 values);
-  }
-
-
-
-  template <int dim>
   Tensor<1, dim>
   FluxReconstruction<dim>::reference_flux(const unsigned int           s,
                                           const std::array<double, 3> &fluxes,
@@ -493,12 +315,13 @@ namespace membranes
   template <int dim>
   void
   FluxReconstruction<dim>::reconstruct(
+    const DoFHandler<dim>           &dof_handler,
     const VectorType                &ghosted_solution,
     const AffineConstraints<double> &hanging_node_constraints,
-    const DiscreteAction<dim>       &action,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator)
   {
+    this->dof_handler                   = &dof_handler;
     const FiniteElement<dim> &fe        = *discretization.fe;
     const auto               &triangles = dual_cell_quadrature.sub_triangles();
     const unsigned int        n_triangles = triangles.size();
@@ -530,7 +353,7 @@ namespace membranes
     std::vector<double>     load(points.n_volume);
 
     const unsigned int n_cells =
-      dof_handler->get_triangulation().n_active_cells();
+      dof_handler.get_triangulation().n_active_cells();
     sub_triangle_data.assign(n_cells * n_triangles, SubTriangleData());
     std::unordered_map<unsigned long long, unsigned int> free_flux_index;
     std::vector<FreeFlux<dim>>                           free_fluxes;
@@ -547,7 +370,7 @@ namespace membranes
     // as on one process, without communication. (At the outer rim of the
     // ghost layer, groups are cut short by artificial cells; they belong
     // to no owned cell.) The patch problems need the owned cells only.
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
@@ -726,7 +549,7 @@ namespace membranes
         }
 
     // The minimizers: the fluxes through the half-edges.
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
@@ -755,7 +578,7 @@ namespace membranes
       local_divergence(dofs_per_cell), local_load_on_pieces(dofs_per_cell),
       local_load_on_hats(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell->get_dof_indices(dof_indices);
@@ -1159,8 +982,7 @@ namespace membranes
     const auto entry = [&](const unsigned int s, const unsigned int k) {
       return patch[s / n_ring][(s % n_ring) * size + k];
     };
-    const double lambda_a =
-      dual_mesh_vertices.is_element(a) ? (*lambda_h)[a] : 0.;
+    const double lambda_a = action.lambda_h_at_vertex(a);
 
     // The unknown fluxes: through the half-edges (or small edges at a
     // hanging node) that two cells of the patch share, found by their
@@ -1511,7 +1333,8 @@ namespace membranes
                   const Tensor<2, dim> DF  = to_tensor(fe_values.jacobian(q));
                   const double         det = std::abs(determinant(DF));
                   patch.data(0, j) = cell->vertex_index(triangles[s].vertex);
-                  patch.data(1, j) = lambda_h_value(cell, triangles[s].vertex);
+                  patch.data(1, j) =
+                    action.lambda_h_value(cell, triangles[s].vertex);
                   for (unsigned int i = 0; i < 2; ++i)
                     {
                       const Tensor<1, dim> t =
@@ -1531,6 +1354,5 @@ namespace membranes
 
 
 
-  template class DualCellQuadrature<2>;
   template class FluxReconstruction<2>;
 } // namespace membranes

@@ -29,7 +29,7 @@ namespace membranes
                         computing_timer,
                         mpi_communicator)
     , error_norms(discretization, data)
-    , flux_reconstruction(discretization, data)
+    , flux_reconstruction(discretization, data, action)
     , error_estimator(discretization, data)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
@@ -214,9 +214,7 @@ namespace membranes
   MembraneProblem<dim>::postprocess()
   {
     compute_lambda_h();
-    flux_reconstruction.set_lambda_h(dof_handler,
-                                     lambda_h,
-                                     action.dual_mesh_vertices());
+    action.set_lambda_h(lambda_h);
 
     double      min_w      = std::numeric_limits<double>::max();
     double      min_lambda = min_w, prop12 = 0, product = 0;
@@ -257,7 +255,7 @@ namespace membranes
       {
         const auto errors    = error_norms.compute(dof_handler,
                                                 ghosted_solution,
-                                                flux_reconstruction,
+                                                action,
                                                 mpi_communicator);
         record.err_u1_H1     = errors.u_H1[0];
         record.err_u2_H1     = errors.u_H1[1];
@@ -273,21 +271,38 @@ namespace membranes
 
 
   /**
-   * The fluxes t_ih of §4.2 and the defects of (4.17), (4.18) and of the
-   * balance of Lemma 17, if the scene asks for the flux reconstruction.
+   * Whether the fluxes are reconstructed: for the flux estimator when it
+   * drives refinement, and when the scene asks for them in the output.
+   */
+  template <int dim>
+  bool
+  MembraneProblem<dim>::computes_fluxes() const
+  {
+    return parameters.refinement.estimator == Parameters::Estimator::flux ||
+           parameters.output.flux_reconstruction;
+  }
+
+
+
+  /**
+   * The fluxes t_ih of §4.2 and σ_ih, if computes_fluxes(); with
+   * `Output/Flux reconstruction`, the defects of (4.17), (4.18) and of the
+   * balance of Lemma 17 for the report.
    */
   template <int dim>
   void
   MembraneProblem<dim>::reconstruct_fluxes()
   {
-    if (!parameters.output.flux_reconstruction)
+    if (!computes_fluxes())
       return;
     TimerOutput::Scope scope(computing_timer, "flux");
-    flux_reconstruction.reconstruct(ghosted_solution,
+    flux_reconstruction.reconstruct(dof_handler,
+                                    ghosted_solution,
                                     hanging_node_constraints,
-                                    action,
                                     locally_owned_dofs,
                                     mpi_communicator);
+    if (!parameters.output.flux_reconstruction)
+      return;
     const auto &identities     = flux_reconstruction.identities();
     record.measure_defect      = identities.measure_defect;
     record.conservation_defect = identities.conservation_defect;
@@ -299,7 +314,7 @@ namespace membranes
   /**
    * The residual estimator η and its indicators η_K², when it drives
    * adaptive refinement or the exact solution is known, and the flux
-   * estimator with the flux reconstruction; with the exact solution, their
+   * estimator and its parts with the fluxes; with the exact solution, their
    * effectivity indices η / |||e|||. The indicators of `Refinement/Estimator`
    * are kept for marking. The time of the flux estimator counts as flux
    * reconstruction time, the rest as estimator time.
@@ -310,30 +325,42 @@ namespace membranes
   {
     const bool adaptive = parameters.refinement.strategy ==
                           Parameters::RefinementStrategy::adaptive;
-    const auto driving = parameters.refinement.estimator;
+    const bool flux_drives =
+      parameters.refinement.estimator == Parameters::Estimator::flux;
     indicators.reinit(0);
-    for (const auto kind :
-         {Parameters::Estimator::residual, Parameters::Estimator::flux})
+    if ((adaptive && !flux_drives) || data.exact_solution_known())
       {
-        const bool flux = (kind == Parameters::Estimator::flux);
-        if (flux ?
-              !parameters.output.flux_reconstruction :
-              !(adaptive && driving == kind) && !data.exact_solution_known())
-          continue;
-        TimerOutput::Scope scope(computing_timer, flux ? "flux" : "estimate");
-        Vector<double>     kind_indicators;
-        const double       eta = error_estimator.estimate(kind,
-                                                    dof_handler,
-                                                    ghosted_solution,
-                                                    flux_reconstruction,
-                                                    kind_indicators,
-                                                    mpi_communicator);
-        (flux ? record.flux_estimator : record.estimator) = eta;
+        TimerOutput::Scope scope(computing_timer, "estimate");
+        Vector<double>     residual_indicators;
+        record.estimator =
+          error_estimator.residual_estimate(dof_handler,
+                                            ghosted_solution,
+                                            action,
+                                            residual_indicators,
+                                            mpi_communicator);
         if (record.err_energy)
-          (flux ? record.flux_effectivity : record.effectivity) =
-            eta / *record.err_energy;
-        if (kind == driving)
-          indicators.swap(kind_indicators);
+          record.effectivity = *record.estimator / *record.err_energy;
+        if (!flux_drives)
+          indicators.swap(residual_indicators);
+      }
+    if (computes_fluxes())
+      {
+        TimerOutput::Scope scope(computing_timer, "flux");
+        Vector<double>     flux_indicators;
+        const auto         estimate = error_estimator.flux_estimate(dof_handler,
+                                                            ghosted_solution,
+                                                            action,
+                                                            flux_reconstruction,
+                                                            flux_indicators,
+                                                            mpi_communicator);
+        record.flux_estimator       = estimate.eta;
+        record.flux_estimator_flux  = estimate.flux;
+        record.flux_estimator_oscillation = estimate.oscillation;
+        record.flux_estimator_contact     = estimate.contact;
+        if (record.err_energy)
+          record.flux_effectivity = estimate.eta / *record.err_energy;
+        if (flux_drives)
+          indicators.swap(flux_indicators);
       }
   }
 
@@ -510,7 +537,7 @@ namespace membranes
     record.time_solve       = time_of("solve");
     record.time_postprocess = time_of("postprocess");
     record.time_estimate    = time_of("estimate");
-    if (parameters.output.flux_reconstruction)
+    if (computes_fluxes())
       record.time_flux = time_of("flux");
   }
 

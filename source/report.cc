@@ -48,7 +48,10 @@ namespace membranes
               r.time_flux,
               r.levels,
               r.processes,
-              r.memory_mb};
+              r.memory_mb,
+              r.flux_estimator_flux,
+              r.flux_estimator_oscillation,
+              r.flux_estimator_contact};
     }
 
     /** Columns that hold whole numbers. */
@@ -103,7 +106,10 @@ namespace membranes
                                                 "time_flux_s",
                                                 "levels",
                                                 "processes",
-                                                "memory_mb"};
+                                                "memory_mb",
+                                                "flux_estimator_flux",
+                                                "flux_estimator_oscillation",
+                                                "flux_estimator_contact"};
     return names;
   }
 
