@@ -2,7 +2,9 @@
 #include <cmath>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
 #include <map>
@@ -943,6 +945,161 @@ namespace membranes
          Utilities::MPI::some_to_some(mpi_communicator, replies))
       for (unsigned int r = 0; r < sent[process].size(); ++r)
         add_patch_result(sent[process][r], buffer.data() + r * result_size);
+    relax_rotations();
+  }
+
+
+
+  /**
+   * Curls of the hat functions of the vertices p of the sub-mesh S_h are
+   * RT0(S_h) fields without divergence: adding one to σ_ih changes the
+   * outward flux of each sub-triangle κ around p by +c through the edge
+   * that enters p and by −c through the one that leaves it (counter-
+   * clockwise), and changes neither div σ_ih nor its normal continuity.
+   * The c that minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the
+   * sub-triangles around p is
+   *
+   *   c = −Σ_κ u_κ·(G_κ F_κ + g_κ) / Σ_κ u_κ·G_κ u_κ,
+   *
+   * with F_κ the fluxes of σ_ih, G_κ the Gram matrix and g_κ the
+   * products (μ_i ∇u_ih, ψ_k)_κ. Two vertices of S_h of the same kind
+   * (vertex a, edge midpoint m_e, cell centre b_K) never lie in the same
+   * sub-triangle, so each sweep updates all vertices of one kind at once,
+   * in any order, and the flux estimator can only decrease. Only vertices
+   * whose sub-triangles close a loop around them are used: not on ∂ω
+   * (the normal flux there stays the patch problems'), not at a hanging
+   * node. On several processes, σ_ih on the ghost cells is brought from
+   * their owners before each sweep over one kind, so that a loop across
+   * the boundary of the owned cells is relaxed alike on every process that
+   * owns one of its cells, as on one process.
+   */
+  template <int dim>
+  void
+  FluxReconstruction<dim>::relax_rotations()
+  {
+    const auto        &triangles   = dual_cell_quadrature.sub_triangles();
+    const unsigned int n_triangles = triangles.size();
+
+    // The corners of each reference sub-triangle, counterclockwise.
+    std::vector<std::array<unsigned int, 3>> counterclockwise(n_triangles);
+    for (unsigned int s = 0; s < n_triangles; ++s)
+      {
+        const auto          &p  = triangles[s].corners;
+        const Tensor<1, dim> e1 = p[1] - p[0], e2 = p[2] - p[0];
+        counterclockwise[s] = (e1[0] * e2[1] - e1[1] * e2[0] > 0 ?
+                                 std::array<unsigned int, 3>{{0, 1, 2}} :
+                                 std::array<unsigned int, 3>{{0, 2, 1}});
+      }
+
+    // The loops of sub-triangles around each vertex p of S_h, keyed by
+    // kind (0: a, 1: m_e, 2: b_K) and index: per sub-triangle its index
+    // in sub_triangle_data, u_κ, and the keys of the corners at the other
+    // ends of the edge that enters p and of the one that leaves it.
+    struct Loop
+    {
+      std::vector<unsigned int>          kappa;
+      std::vector<std::array<double, 3>> u;
+      std::vector<unsigned long long>    from, to;
+      bool                               owned = false;
+    };
+    std::array<std::unordered_map<unsigned long long, Loop>, 3> loops;
+    for (const auto &cell : dof_handler->active_cell_iterators())
+      if (!cell->is_artificial())
+        for (unsigned int s = 0; s < n_triangles; ++s)
+          {
+            const std::array<unsigned long long, 3> keys{
+              {cell->vertex_index(triangles[s].vertex),
+               static_cast<unsigned long long>(
+                 cell->face(triangles[s].face)->index()),
+               cell->active_cell_index()}};
+            const auto &order = counterclockwise[s];
+            for (unsigned int k = 0; k < 3; ++k)
+              {
+                // Corner order[k] is p, order[k−1] before and order[k+1]
+                // after it; the edge entering p is opposite order[k+1].
+                const unsigned int before = order[(k + 2) % 3],
+                                   corner = order[k],
+                                   after  = order[(k + 1) % 3];
+                Loop &loop                = loops[corner][keys[corner]];
+                loop.owned |= cell->is_locally_owned();
+                loop.kappa.push_back(cell->active_cell_index() * n_triangles +
+                                     s);
+                std::array<double, 3> u{};
+                u[after]  = 1;
+                u[before] = -1;
+                loop.u.push_back(u);
+                loop.from.push_back(3 * keys[before] + before);
+                loop.to.push_back(3 * keys[after] + after);
+              }
+          }
+    std::array<std::vector<Loop>, 3> closed;
+    for (unsigned int kind = 0; kind < 3; ++kind)
+      for (auto &[key, loop] : loops[kind])
+        {
+          auto from = loop.from, to = loop.to;
+          std::sort(from.begin(), from.end());
+          std::sort(to.begin(), to.end());
+          if (loop.owned && from == to &&
+              std::adjacent_find(from.begin(), from.end()) == from.end())
+            closed[kind].push_back(std::move(loop));
+        }
+
+    // σ_ih of the owned cells to the ghost cells of the other processes.
+    using Fluxes        = std::array<std::array<double, 3>, 2>;
+    const auto exchange = [&]() {
+      if (dynamic_cast<const parallel::TriangulationBase<dim> *>(
+            &dof_handler->get_triangulation()) == nullptr)
+        return;
+      GridTools::exchange_cell_data_to_ghosts<std::vector<Fluxes>,
+                                              DoFHandler<dim>>(
+        *dof_handler,
+        [&](const CellIterator &cell) {
+          std::vector<Fluxes> fluxes(n_triangles);
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            fluxes[s] =
+              sub_triangle_data[cell->active_cell_index() * n_triangles + s]
+                .equilibrated;
+          return std::optional<std::vector<Fluxes>>(fluxes);
+        },
+        [&](const CellIterator &cell, const std::vector<Fluxes> &fluxes) {
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            sub_triangle_data[cell->active_cell_index() * n_triangles + s]
+              .equilibrated = fluxes[s];
+        });
+    };
+
+    for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
+      for (const unsigned int kind : {2u, 1u, 0u})
+        {
+          exchange();
+          for (const Loop &loop : closed[kind])
+            for (unsigned int i = 0; i < 2; ++i)
+              {
+                double numerator = 0, denominator = 0;
+                for (unsigned int t = 0; t < loop.kappa.size(); ++t)
+                  {
+                    const SubTriangleData &kappa =
+                      sub_triangle_data[loop.kappa[t]];
+                    const auto &u = loop.u[t];
+                    for (unsigned int k = 0; k < 3; ++k)
+                      {
+                        double Gu = 0, GF = 0;
+                        for (unsigned int l = 0; l < 3; ++l)
+                          {
+                            Gu += kappa.gram[k][l] * u[l];
+                            GF += kappa.gram[k][l] * kappa.equilibrated[i][l];
+                          }
+                        numerator += u[k] * (GF + kappa.discrete_flux[i][k]);
+                        denominator += u[k] * Gu;
+                      }
+                  }
+                const double c = -numerator / denominator;
+                for (unsigned int t = 0; t < loop.kappa.size(); ++t)
+                  for (unsigned int k = 0; k < 3; ++k)
+                    sub_triangle_data[loop.kappa[t]].equilibrated[i][k] +=
+                      c * loop.u[t][k];
+              }
+        }
   }
 
 

@@ -118,6 +118,17 @@ namespace membranes
    * fine side carry the same flux density (one unknown), which keeps
    * σ_ih conforming but not exact for linear u_ih there.
    *
+   * The sum of the patch minimizers is not the field of RT0(S_h) with
+   * this divergence that is closest to −μ_i ∇u_ih. Three sweeps of
+   * divergence-free corrections bring it closer (relax_rotations()): the
+   * curl of the hat function of each vertex p of S_h (a, m_e or b_K) is a
+   * rotation of the fluxes around p, and its coefficient is the one that
+   * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
+   * around p. Neither div σ_ih nor its normal continuity change, and the
+   * flux estimator only decreases (measured on P1: case M 1.087 → 1.042,
+   * the L-shape 1.28 → 1.20 on uniform meshes of 3·10⁴ DoFs). Vertices on
+   * ∂ω and at hanging nodes are left out.
+   *
    * On each cell the sub-triangles form a ring around b_K; with the
    * fluxes through their half-edges and one circulation per cell, the
    * divergence constraints inside the cell are solved in closed form, so a
@@ -306,6 +317,18 @@ namespace membranes
                         const std::vector<const double *> &patch,
                         const std::vector<double *>       &result,
                         PatchScratch                      &scratch) const;
+
+    /**
+     * Divergence-free corrections of σ_ih on the locally owned cells: the
+     * curls of the hat functions of the vertices of S_h, each chosen to
+     * minimize the distance of σ_ih from −μ_i ∇u_ih around its vertex,
+     * in rotation_sweeps sweeps (see the .cc file).
+     */
+    void
+    relax_rotations();
+
+    /** Sweeps of relax_rotations(). */
+    static constexpr unsigned int rotation_sweeps = 3;
 
     /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
     void
