@@ -963,15 +963,14 @@ namespace membranes
    *
    * with F_κ the fluxes of σ_ih, G_κ the Gram matrix and g_κ the
    * products (μ_i ∇u_ih, ψ_k)_κ. Two vertices of S_h of the same kind
-   * (vertex a, edge midpoint m_e, cell centre b_K) never lie in the same
-   * sub-triangle, so each sweep updates all vertices of one kind at once,
-   * in any order, and the flux estimator can only decrease. Only vertices
-   * whose sub-triangles close a loop around them are used: not on ∂ω
-   * (the normal flux there stays the patch problems'), not at a hanging
-   * node. On several processes, σ_ih on the ghost cells is brought from
-   * their owners before each sweep over one kind, so that a loop across
-   * the boundary of the owned cells is relaxed alike on every process that
-   * owns one of its cells, as on one process.
+   * (regular vertex a, edge midpoint m_e, cell centre b_K, hanging vertex)
+   * never lie in the same sub-triangle, so each sweep updates all vertices
+   * of one kind at once, in any order, and the flux estimator can only
+   * decrease. Vertices on ∂ω are left out (the normal flux there stays
+   * the patch problems'). On several processes, σ_ih on the ghost cells
+   * is brought from their owners before each sweep over one kind, so that
+   * a rotation across the boundary of the owned cells is the same on every
+   * process that owns one of its cells, as on one process.
    */
   template <int dim>
   void
@@ -991,58 +990,88 @@ namespace membranes
                                  std::array<unsigned int, 3>{{0, 2, 1}});
       }
 
-    // The loops of sub-triangles around each vertex p of S_h, keyed by
-    // kind (0: a, 1: m_e, 2: b_K) and index: per sub-triangle its index
-    // in sub_triangle_data, u_κ, and the keys of the corners at the other
-    // ends of the edge that enters p and of the one that leaves it.
+    // The rotations, keyed by the vertex p of S_h and its kind (0: a
+    // regular vertex, 1: m_e, 2: b_K, 3: a hanging vertex): per
+    // sub-triangle its index in sub_triangle_data and the change u_κ of its
+    // fluxes. At an edge with a hanging vertex c the stream function is
+    // continuous on S_h: the coarse side's m_e is c, and on the fine side
+    // the midpoint of each small edge takes half of the hat functions of
+    // its two ends. Vertices of one kind then still share no sub-triangle.
     struct Loop
     {
       std::vector<unsigned int>          kappa;
       std::vector<std::array<double, 3>> u;
-      std::vector<unsigned long long>    from, to;
-      bool                               owned = false;
+      bool                               owned       = false;
+      bool                               on_boundary = false;
     };
-    std::array<std::unordered_map<unsigned long long, Loop>, 3> loops;
+    std::array<std::unordered_map<unsigned long long, Loop>, 4> loops;
+    struct Node
+    {
+      unsigned int       kind;
+      unsigned long long key;
+      double             weight;
+    };
+    std::vector<bool> hanging(dof_handler->get_triangulation().n_vertices());
+    for (const auto &cell : dof_handler->active_cell_iterators())
+      if (!cell->is_artificial())
+        for (const unsigned int f : cell->face_indices())
+          if (!cell->at_boundary(f) && cell->face(f)->has_children())
+            hanging[cell->face(f)->child(0)->vertex_index(1)] = true;
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (!cell->is_artificial())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
-            const std::array<unsigned long long, 3> keys{
-              {cell->vertex_index(triangles[s].vertex),
-               static_cast<unsigned long long>(
-                 cell->face(triangles[s].face)->index()),
-               cell->active_cell_index()}};
-            const auto &order = counterclockwise[s];
+            const unsigned int f           = triangles[s].face;
+            const auto         face        = cell->face(f);
+            const bool         on_boundary = cell->at_boundary(f);
+            const auto         vertex_node = [&](const unsigned int v) {
+              return Node{hanging[v] ? 3u : 0u, v, 1.};
+            };
+            std::array<std::vector<Node>, 3> nodes;
+            nodes[0] = {vertex_node(cell->vertex_index(triangles[s].vertex))};
+            if (!on_boundary && face->has_children())
+              nodes[1] = {vertex_node(face->child(0)->vertex_index(1))};
+            else if (!on_boundary && cell->neighbor_is_coarser(f))
+              nodes[1] = {Node{vertex_node(face->vertex_index(0)).kind,
+                               face->vertex_index(0),
+                               0.5},
+                          Node{vertex_node(face->vertex_index(1)).kind,
+                               face->vertex_index(1),
+                               0.5}};
+            else
+              nodes[1] = {
+                Node{1, static_cast<unsigned long long>(face->index()), 1.}};
+            nodes[2]              = {Node{2, cell->active_cell_index(), 1.}};
+            const unsigned int id = cell->active_cell_index() * n_triangles + s;
+            const auto        &order = counterclockwise[s];
             for (unsigned int k = 0; k < 3; ++k)
               {
                 // Corner order[k] is p, order[k−1] before and order[k+1]
-                // after it; the edge entering p is opposite order[k+1].
+                // after it: the edge entering p is opposite order[k+1].
                 const unsigned int before = order[(k + 2) % 3],
                                    corner = order[k],
                                    after  = order[(k + 1) % 3];
-                Loop &loop                = loops[corner][keys[corner]];
-                loop.owned |= cell->is_locally_owned();
-                loop.kappa.push_back(cell->active_cell_index() * n_triangles +
-                                     s);
-                std::array<double, 3> u{};
-                u[after]  = 1;
-                u[before] = -1;
-                loop.u.push_back(u);
-                loop.from.push_back(3 * keys[before] + before);
-                loop.to.push_back(3 * keys[after] + after);
+                for (const Node &node : nodes[corner])
+                  {
+                    Loop &loop = loops[node.kind][node.key];
+                    loop.owned |= cell->is_locally_owned();
+                    // p on ∂ω: a vertex of a boundary edge, or its m_e.
+                    loop.on_boundary |= on_boundary && corner != 2;
+                    if (loop.kappa.empty() || loop.kappa.back() != id)
+                      {
+                        loop.kappa.push_back(id);
+                        loop.u.emplace_back();
+                      }
+                    loop.u.back()[after] += node.weight;
+                    loop.u.back()[before] -= node.weight;
+                  }
               }
           }
-    std::array<std::vector<Loop>, 3> closed;
-    for (unsigned int kind = 0; kind < 3; ++kind)
+    std::array<std::vector<Loop>, 4> closed;
+    for (unsigned int kind = 0; kind < 4; ++kind)
       for (auto &[key, loop] : loops[kind])
-        {
-          auto from = loop.from, to = loop.to;
-          std::sort(from.begin(), from.end());
-          std::sort(to.begin(), to.end());
-          if (loop.owned && from == to &&
-              std::adjacent_find(from.begin(), from.end()) == from.end())
-            closed[kind].push_back(std::move(loop));
-        }
+        if (loop.owned && !loop.on_boundary)
+          closed[kind].push_back(std::move(loop));
 
     // σ_ih of the owned cells to the ghost cells of the other processes.
     using Fluxes        = std::array<std::array<double, 3>, 2>;
@@ -1069,7 +1098,7 @@ namespace membranes
     };
 
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
-      for (const unsigned int kind : {2u, 1u, 0u})
+      for (const unsigned int kind : {2u, 1u, 0u, 3u})
         {
           exchange();
           for (const Loop &loop : closed[kind])

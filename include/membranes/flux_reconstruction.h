@@ -126,8 +126,13 @@ namespace membranes
    * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
    * around p. Neither div σ_ih nor its normal continuity change, and the
    * flux estimator only decreases (measured on P1: case M 1.087 → 1.042,
-   * the L-shape 1.28 → 1.20 on uniform meshes of 3·10⁴ DoFs). Vertices on
-   * ∂ω and at hanging nodes are left out.
+   * the L-shape 1.28 → 1.20 on uniform meshes of 3·10⁴ DoFs). At an edge
+   * with a hanging vertex c the stream function stays continuous on S_h:
+   * c is the coarse side's m_e, and the midpoints of the two small edges
+   * take half of the hat functions of their ends, which carries the
+   * corrections across (P1 adaptive: the straight free boundary
+   * 1.389 → 1.044, the disk 1.378 → 1.085). Vertices on ∂ω are left out:
+   * the normal flux there stays that of the patch problems.
    *
    * On each cell the sub-triangles form a ring around b_K; with the
    * fluxes through their half-edges and one circulation per cell, the
