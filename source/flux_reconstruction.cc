@@ -990,60 +990,57 @@ namespace membranes
                                  std::array<unsigned int, 3>{{0, 2, 1}});
       }
 
-    // The rotations, keyed by the vertex p of S_h and its kind (0: a
-    // regular vertex, 1: m_e, 2: b_K, 3: a hanging vertex): per
-    // sub-triangle its index in sub_triangle_data and the change u_κ of its
-    // fluxes. At an edge with a hanging vertex c the stream function is
-    // continuous on S_h: the coarse side's m_e is c, and on the fine side
-    // the midpoint of each small edge takes half of the hat functions of
-    // its two ends. Vertices of one kind then still share no sub-triangle.
-    struct Loop
+    // The rotations, by the vertex p of S_h: the vertices of the mesh
+    // first, then the faces (their midpoints m_e), then the cells (b_K).
+    // Per sub-triangle around p its index in sub_triangle_data and the
+    // change u_κ of its fluxes. At an edge with a hanging vertex c the
+    // stream function is continuous on S_h: the coarse side's m_e is c, and
+    // on the fine side the midpoint of each small edge takes half of the
+    // hat functions of its two ends.
+    const auto        &triangulation = dof_handler->get_triangulation();
+    const unsigned int n_vertices    = triangulation.n_vertices();
+    const unsigned int first_cell    = n_vertices + triangulation.n_raw_faces();
+    const unsigned int n_nodes = first_cell + triangulation.n_active_cells();
+    struct Entry
     {
-      std::vector<unsigned int>          kappa;
-      std::vector<std::array<double, 3>> u;
-      bool                               owned       = false;
-      bool                               on_boundary = false;
+      unsigned int          node, kappa;
+      std::array<double, 3> u;
     };
-    std::array<std::unordered_map<unsigned long long, Loop>, 4> loops;
-    struct Node
-    {
-      unsigned int       kind;
-      unsigned long long key;
-      double             weight;
-    };
-    std::vector<bool> hanging(dof_handler->get_triangulation().n_vertices());
+    std::vector<Entry> entries;
+    entries.reserve(triangulation.n_active_cells() * n_triangles * 3);
+    std::vector<char> owned(n_nodes, 0), on_boundary(n_nodes, 0);
+    std::vector<char> hanging(n_vertices, 0);
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (!cell->is_artificial())
         for (const unsigned int f : cell->face_indices())
           if (!cell->at_boundary(f) && cell->face(f)->has_children())
-            hanging[cell->face(f)->child(0)->vertex_index(1)] = true;
+            hanging[cell->face(f)->child(0)->vertex_index(1)] = 1;
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (!cell->is_artificial())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
-            const unsigned int f           = triangles[s].face;
-            const auto         face        = cell->face(f);
-            const bool         on_boundary = cell->at_boundary(f);
-            const auto         vertex_node = [&](const unsigned int v) {
-              return Node{hanging[v] ? 3u : 0u, v, 1.};
-            };
-            std::array<std::vector<Node>, 3> nodes;
-            nodes[0] = {vertex_node(cell->vertex_index(triangles[s].vertex))};
-            if (!on_boundary && face->has_children())
-              nodes[1] = {vertex_node(face->child(0)->vertex_index(1))};
-            else if (!on_boundary && cell->neighbor_is_coarser(f))
-              nodes[1] = {Node{vertex_node(face->vertex_index(0)).kind,
-                               face->vertex_index(0),
-                               0.5},
-                          Node{vertex_node(face->vertex_index(1)).kind,
-                               face->vertex_index(1),
-                               0.5}};
+            const unsigned int f        = triangles[s].face;
+            const auto         face     = cell->face(f);
+            const bool         boundary = cell->at_boundary(f);
+            // The vertices of S_h at the corners a, m_e, b_K, with weights.
+            std::array<std::array<std::pair<unsigned int, double>, 2>, 3> nodes;
+            std::array<unsigned int, 3> n_nodes_of{{1, 1, 1}};
+            nodes[0][0] = {cell->vertex_index(triangles[s].vertex), 1.};
+            if (!boundary && face->has_children())
+              nodes[1][0] = {face->child(0)->vertex_index(1), 1.};
+            else if (!boundary && cell->neighbor_is_coarser(f))
+              {
+                nodes[1] = {
+                  {{face->vertex_index(0), 0.5}, {face->vertex_index(1), 0.5}}};
+                n_nodes_of[1] = 2;
+              }
             else
-              nodes[1] = {
-                Node{1, static_cast<unsigned long long>(face->index()), 1.}};
-            nodes[2]              = {Node{2, cell->active_cell_index(), 1.}};
+              nodes[1][0] = {n_vertices + face->index(), 1.};
+            nodes[2][0] = {first_cell + cell->active_cell_index(), 1.};
+
             const unsigned int id = cell->active_cell_index() * n_triangles + s;
-            const auto        &order = counterclockwise[s];
+            const std::size_t  first_entry = entries.size();
+            const auto        &order       = counterclockwise[s];
             for (unsigned int k = 0; k < 3; ++k)
               {
                 // Corner order[k] is p, order[k−1] before and order[k+1]
@@ -1051,27 +1048,46 @@ namespace membranes
                 const unsigned int before = order[(k + 2) % 3],
                                    corner = order[k],
                                    after  = order[(k + 1) % 3];
-                for (const Node &node : nodes[corner])
+                for (unsigned int n = 0; n < n_nodes_of[corner]; ++n)
                   {
-                    Loop &loop = loops[node.kind][node.key];
-                    loop.owned |= cell->is_locally_owned();
+                    const auto [node, weight] = nodes[corner][n];
+                    owned[node] |= cell->is_locally_owned();
                     // p on ∂ω: a vertex of a boundary edge, or its m_e.
-                    loop.on_boundary |= on_boundary && corner != 2;
-                    if (loop.kappa.empty() || loop.kappa.back() != id)
-                      {
-                        loop.kappa.push_back(id);
-                        loop.u.emplace_back();
-                      }
-                    loop.u.back()[after] += node.weight;
-                    loop.u.back()[before] -= node.weight;
+                    on_boundary[node] |= boundary && corner != 2;
+                    auto entry = std::find_if(entries.begin() + first_entry,
+                                              entries.end(),
+                                              [node = node](const Entry &e) {
+                                                return e.node == node;
+                                              });
+                    if (entry == entries.end())
+                      entry =
+                        entries.insert(entries.end(), Entry{node, id, {}});
+                    entry->u[after] += weight;
+                    entry->u[before] -= weight;
                   }
               }
           }
-    std::array<std::vector<Loop>, 4> closed;
-    for (unsigned int kind = 0; kind < 4; ++kind)
-      for (auto &[key, loop] : loops[kind])
-        if (loop.owned && !loop.on_boundary)
-          closed[kind].push_back(std::move(loop));
+    // The entries sorted by vertex (counting sort), and the vertices of
+    // each kind (0: regular vertex, 1: m_e, 2: b_K, 3: hanging vertex):
+    // two of one kind share no sub-triangle.
+    std::vector<unsigned int> start(n_nodes + 1, 0);
+    for (const Entry &entry : entries)
+      ++start[entry.node + 1];
+    for (unsigned int node = 0; node < n_nodes; ++node)
+      start[node + 1] += start[node];
+    std::vector<Entry> sorted(entries.size());
+    {
+      std::vector<unsigned int> next(start.begin(), start.end() - 1);
+      for (const Entry &entry : entries)
+        sorted[next[entry.node]++] = entry;
+    }
+    std::array<std::vector<unsigned int>, 4> of_kind;
+    for (unsigned int node = 0; node < n_nodes; ++node)
+      if (owned[node] && !on_boundary[node] && start[node + 1] > start[node])
+        of_kind[node < n_vertices ? (hanging[node] ? 3 : 0) :
+                node < first_cell ? 1 :
+                                    2]
+          .push_back(node);
 
     // σ_ih of the owned cells to the ghost cells of the other processes.
     using Fluxes        = std::array<std::array<double, 3>, 2>;
@@ -1101,15 +1117,15 @@ namespace membranes
       for (const unsigned int kind : {2u, 1u, 0u, 3u})
         {
           exchange();
-          for (const Loop &loop : closed[kind])
+          for (const unsigned int node : of_kind[kind])
             for (unsigned int i = 0; i < 2; ++i)
               {
                 double numerator = 0, denominator = 0;
-                for (unsigned int t = 0; t < loop.kappa.size(); ++t)
+                for (unsigned int t = start[node]; t < start[node + 1]; ++t)
                   {
                     const SubTriangleData &kappa =
-                      sub_triangle_data[loop.kappa[t]];
-                    const auto &u = loop.u[t];
+                      sub_triangle_data[sorted[t].kappa];
+                    const auto &u = sorted[t].u;
                     for (unsigned int k = 0; k < 3; ++k)
                       {
                         double Gu = 0, GF = 0;
@@ -1123,10 +1139,10 @@ namespace membranes
                       }
                   }
                 const double c = -numerator / denominator;
-                for (unsigned int t = 0; t < loop.kappa.size(); ++t)
+                for (unsigned int t = start[node]; t < start[node + 1]; ++t)
                   for (unsigned int k = 0; k < 3; ++k)
-                    sub_triangle_data[loop.kappa[t]].equilibrated[i][k] +=
-                      c * loop.u[t][k];
+                    sub_triangle_data[sorted[t].kappa].equilibrated[i][k] +=
+                      c * sorted[t].u[k];
               }
         }
   }
