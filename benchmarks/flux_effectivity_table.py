@@ -8,7 +8,8 @@ over all cycles, and the parts of η on the last cycle relative to the
 energy error |||e|||: flux (Σ_i η_F,i²)^½, oscillation (Σ_i η_R,i²)^½,
 contact (2B)^½; the part with the largest share is named. Since
 η² = Σ_i (η_F,i + η_R,i)² + 2B, η/|||e||| − 1 is what the parts exceed
-the error by.
+the error by. Last, the boundary data part (flux_estimator_boundary, not
+in η) relative to the error.
 """
 import csv
 import os
@@ -26,8 +27,9 @@ def number(row, column):
 
 def main(runs):
     print("| run | DoFs | effectivity (last) | effectivity (range) "
-          "| flux/err | oscillation/err | contact/err | dominant |")
-    print("|---|--:|--:|--:|--:|--:|--:|---|")
+          "| flux/err | oscillation/err | contact/err | dominant "
+          "| boundary/err |")
+    print("|---|--:|--:|--:|--:|--:|--:|---|--:|")
     for run in runs:
         rows = read(run)
         last = rows[-1]
@@ -39,7 +41,8 @@ def main(runs):
         print(f"| {os.path.basename(os.path.normpath(run))} | {last['dofs']} "
               f"| {eff[-1]:.3f} | {min(eff):.3f}..{max(eff):.3f} "
               f"| {parts['flux']:.3f} | {parts['oscillation']:.3f} "
-              f"| {parts['contact']:.3f} | {dominant} |")
+              f"| {parts['contact']:.3f} | {dominant} "
+              f"| {number(last, 'flux_estimator_boundary') / error:.3f} |")
 
 
 if __name__ == "__main__":

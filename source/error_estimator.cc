@@ -341,7 +341,50 @@ namespace membranes
     estimate.flux        = std::sqrt(sums[0] + sums[2]);
     estimate.oscillation = std::sqrt(sums[1] + sums[3]);
     estimate.contact     = std::sqrt(2 * sums[4]);
+    estimate.boundary =
+      boundary_data_part(dof_handler, ghosted_solution, mpi_communicator);
     return estimate;
+  }
+
+
+
+  template <int dim>
+  double
+  ErrorEstimator<dim>::boundary_data_part(const DoFHandler<dim> &dof_handler,
+                                          const VectorType &ghosted_solution,
+                                          const MPI_Comm mpi_communicator) const
+  {
+    const FiniteElement<dim> &fe = *discretization.fe;
+    const Quadrature<dim - 1> quadrature =
+      fe.reference_cell().is_simplex() ?
+        Quadrature<dim - 1>(QGaussSimplex<dim - 1>(3)) :
+        Quadrature<dim - 1>(QGauss<dim - 1>(3));
+    FEFaceValues<dim>           face_values(*discretization.mapping,
+                                  fe,
+                                  quadrature,
+                                  update_values | update_quadrature_points |
+                                    update_JxW_values);
+    std::vector<Vector<double>> u(quadrature.size(), Vector<double>(2)),
+      g(quadrature.size(), Vector<double>(2));
+    double sum = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->at_boundary())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f))
+            {
+              face_values.reinit(cell, f);
+              face_values.get_function_values(ghosted_solution, u);
+              data.boundary_values().vector_value_list(
+                face_values.get_quadrature_points(), g);
+              double integral = 0;
+              for (const unsigned int q :
+                   face_values.quadrature_point_indices())
+                for (unsigned int i = 0; i < 2; ++i)
+                  integral += data.mu[i] * std::pow(g[q][i] - u[q][i], 2) *
+                              face_values.JxW(q);
+              sum += integral / cell->face(f)->measure();
+            }
+    return std::sqrt(Utilities::MPI::sum(sum, mpi_communicator));
   }
 
 

@@ -357,6 +357,7 @@ namespace membranes
         record.flux_estimator_flux  = estimate.flux;
         record.flux_estimator_oscillation = estimate.oscillation;
         record.flux_estimator_contact     = estimate.contact;
+        record.flux_estimator_boundary    = estimate.boundary;
         if (record.err_energy)
           record.flux_effectivity = estimate.eta / *record.err_energy;
         if (flux_drives)

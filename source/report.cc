@@ -51,7 +51,8 @@ namespace membranes
               r.memory_mb,
               r.flux_estimator_flux,
               r.flux_estimator_oscillation,
-              r.flux_estimator_contact};
+              r.flux_estimator_contact,
+              r.flux_estimator_boundary};
     }
 
     /** Columns that hold whole numbers. */
@@ -109,7 +110,8 @@ namespace membranes
                                                 "memory_mb",
                                                 "flux_estimator_flux",
                                                 "flux_estimator_oscillation",
-                                                "flux_estimator_contact"};
+                                                "flux_estimator_contact",
+                                                "flux_estimator_boundary"};
     return names;
   }
 

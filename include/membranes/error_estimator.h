@@ -124,6 +124,13 @@ namespace membranes
       double oscillation = 0;
       /** (2 B)^{1/2}: the contact term. */
       double contact = 0;
+      /**
+       * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
+       * g_2 = g2: the size of the energy of a lifting of the boundary
+       * data error into the cells along ∂ω (constant 1), which the
+       * argument for η assumes to vanish. Not part of η.
+       */
+      double boundary = 0;
     };
 
     ErrorEstimator(const Discretization<dim> &discretization,
@@ -160,6 +167,12 @@ namespace membranes
                    const VectorType          &ghosted_solution,
                    const DiscreteAction<dim> &action,
                    Vector<double>            &indicators) const;
+
+    /** The boundary data part of FluxEstimate. */
+    double
+    boundary_data_part(const DoFHandler<dim> &dof_handler,
+                       const VectorType      &ghosted_solution,
+                       const MPI_Comm         mpi_communicator) const;
 
     /** ½ h_e μ_i⁻¹ ‖[μ_i ∂_n u_ih]‖²_e on both cells of every interior edge. */
     void

@@ -52,6 +52,11 @@ namespace membranes
     std::optional<double> flux_estimator_flux, flux_estimator_oscillation,
       flux_estimator_contact;
     /**
+     * The boundary data part (ErrorEstimator::FluxEstimate::boundary), not
+     * part of the flux estimator; with it.
+     */
+    std::optional<double> flux_estimator_boundary;
+    /**
      * Defects of (4.17), (4.18) and of the balance of Lemma 17 (see
      * FluxReconstruction::Identities), with the flux reconstruction.
      */
