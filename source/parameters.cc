@@ -676,8 +676,8 @@ namespace membranes::Parameters
                       "global",
                       Selection("global|adaptive"),
                       "global: every cell is refined in every cycle; "
-                      "adaptive: cells are marked by the residual "
-                      "estimator.");
+                      "adaptive: cells are marked by the estimator of "
+                      "'Estimator'.");
     prm.declare_entry("Cycles",
                       "6",
                       Integer(1, 100),
