@@ -15,6 +15,8 @@ namespace membranes
                                       const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
+    , dual_cell_quadrature(discretization.fe->reference_cell(), 2)
+    , lambda_h_vector(nullptr)
     , loads_per_cell(0)
     , max_force(0)
     , l2_force(0)
@@ -320,6 +322,87 @@ namespace membranes
   DiscreteAction<dim>::force_scale_l2() const
   {
     return l2_force;
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::set_lambda_h(const VectorType &lambda_h)
+  {
+    lambda_h_vector = &lambda_h;
+  }
+
+
+
+  template <int dim>
+  const DualCellQuadrature<dim> &
+  DiscreteAction<dim>::dual_quadrature() const
+  {
+    return dual_cell_quadrature;
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::lambda_h_value(
+    const typename DoFHandler<dim>::active_cell_iterator &cell,
+    const unsigned int                                    v) const
+  {
+    return lambda_h_at_vertex(cell->vertex_dof_index(v, 0));
+  }
+
+
+
+  template <int dim>
+  double
+  DiscreteAction<dim>::lambda_h_at_vertex(const types::global_dof_index a) const
+  {
+    return interior_vertex_dofs.is_element(a) ? (*lambda_h_vector)[a] : 0.;
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::lambda_h_values(
+    const typename DoFHandler<dim>::active_cell_iterator &cell,
+    std::vector<double>                                  &values,
+    std::vector<bool>                                    *in_omega_h) const
+  {
+    // λ_h is constant on the pieces of each vertex: look it up once per
+    // vertex, not once per point.
+    std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
+    std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
+    for (const unsigned int v : cell->vertex_indices())
+      {
+        vertex_values[v] = lambda_h_value(cell, v);
+        vertex_in_omega_h[v] =
+          interior_vertex_dofs.is_element(cell->vertex_dof_index(v, 0));
+      }
+    values.resize(dual_cell_quadrature.quadrature().size());
+    if (in_omega_h)
+      in_omega_h->resize(values.size());
+    for (unsigned int q = 0; q < values.size(); ++q)
+      {
+        const unsigned int v = dual_cell_quadrature.vertex_of_point(q);
+        values[q]            = vertex_values[v];
+        if (in_omega_h)
+          (*in_omega_h)[q] = vertex_in_omega_h[v];
+      }
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteAction<dim>::nodal_lambda_values(const FEValues<dim> &fe_values,
+                                           std::vector<double> &values) const
+  {
+    values.resize(fe_values.n_quadrature_points);
+    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(
+      *lambda_h_vector, values);
   }
 
 

@@ -10,37 +10,23 @@ namespace membranes
 {
   template <int dim>
   ErrorEstimator<dim>::ErrorEstimator(const Discretization<dim> &discretization,
-                                      const ProblemData<dim>    &data,
-                                      const DiscreteAction<dim> &action)
+                                      const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
-    , action(action)
   {}
 
 
 
   template <int dim>
   double
-  ErrorEstimator<dim>::estimate(
-    const Parameters::Estimator    kind,
-    const DoFHandler<dim>         &dof_handler,
-    const VectorType              &ghosted_solution,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    Vector<double>                &indicators,
-    const MPI_Comm                 mpi_communicator) const
+  ErrorEstimator<dim>::residual_estimate(const DoFHandler<dim> &dof_handler,
+                                         const VectorType &ghosted_solution,
+                                         const DiscreteAction<dim> &action,
+                                         Vector<double>            &indicators,
+                                         const MPI_Comm mpi_communicator) const
   {
-    if (kind == Parameters::Estimator::flux)
-      return flux_estimate(dof_handler,
-                           ghosted_solution,
-                           flux_reconstruction,
-                           indicators,
-                           mpi_communicator);
-
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    add_cell_terms(dof_handler,
-                   ghosted_solution,
-                   flux_reconstruction,
-                   indicators);
+    add_cell_terms(dof_handler, ghosted_solution, action, indicators);
     add_jump_terms(dof_handler, ghosted_solution, indicators);
 
     double local_sum = 0;
@@ -56,11 +42,10 @@ namespace membranes
 
   template <int dim>
   void
-  ErrorEstimator<dim>::add_cell_terms(
-    const DoFHandler<dim>         &dof_handler,
-    const VectorType              &ghosted_solution,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    Vector<double>                &indicators) const
+  ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
+                                      const VectorType      &ghosted_solution,
+                                      const DiscreteAction<dim> &action,
+                                      Vector<double> &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
@@ -68,7 +53,7 @@ namespace membranes
     const bool         with_laplacians = !fe.reference_cell().is_simplex();
     FEValues<dim>      fe_values(*discretization.mapping,
                             fe,
-                            flux_reconstruction.dual_quadrature().quadrature(),
+                            action.dual_quadrature().quadrature(),
                             update_values | update_JxW_values |
                               (with_laplacians ? update_hessians :
                                                       update_default));
@@ -86,7 +71,7 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          flux_reconstruction.lambda_h_values(cell, lambda);
+          action.lambda_h_values(cell, lambda);
 
           const double h_K     = cell->diameter();
           double       eta2    = 0;
@@ -259,22 +244,23 @@ namespace membranes
 
 
   template <int dim>
-  double
+  typename ErrorEstimator<dim>::FluxEstimate
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>         &dof_handler,
     const VectorType              &ghosted_solution,
+    const DiscreteAction<dim>     &action,
     const FluxReconstruction<dim> &flux_reconstruction,
     Vector<double>                &indicators,
     const MPI_Comm                 mpi_communicator) const
   {
-    const auto &quadrature = flux_reconstruction.dual_quadrature().quadrature();
-    FEValues<dim>                      fe_values(*discretization.mapping,
+    const auto        &quadrature = action.dual_quadrature().quadrature();
+    FEValues<dim>      fe_values(*discretization.mapping,
                             *discretization.fe,
                             quadrature,
                             update_values | update_gradients |
                               update_jacobians | update_JxW_values);
-    const unsigned int                 n_q_points = quadrature.size();
-    std::array<std::vector<double>, 2> u;
+    const unsigned int n_q_points = quadrature.size();
+    std::array<std::vector<double>, 2>         u;
     std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
     std::vector<Tensor<1, dim>>                flux;
     std::vector<double>                        divergence, lambda;
@@ -292,7 +278,7 @@ namespace membranes
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
-          flux_reconstruction.nodal_lambda_values(fe_values, lambda);
+          action.nodal_lambda_values(fe_values, lambda);
           const double h_K  = cell->diameter();
           double       eta2 = 0;
           for (unsigned int i = 0; i < 2; ++i)
@@ -330,10 +316,58 @@ namespace membranes
 
     for (double &sum : sums)
       sum = Utilities::MPI::sum(sum, mpi_communicator);
-    double eta2 = 2 * sums[4];
+    FluxEstimate estimate;
+    double       eta2 = 2 * sums[4];
     for (unsigned int i = 0; i < 2; ++i)
       eta2 += std::pow(std::sqrt(sums[2 * i]) + std::sqrt(sums[2 * i + 1]), 2);
-    return std::sqrt(eta2);
+    estimate.eta         = std::sqrt(eta2);
+    estimate.flux        = std::sqrt(sums[0] + sums[2]);
+    estimate.oscillation = std::sqrt(sums[1] + sums[3]);
+    estimate.contact     = std::sqrt(2 * sums[4]);
+    estimate.boundary =
+      boundary_data_part(dof_handler, ghosted_solution, mpi_communicator);
+    return estimate;
+  }
+
+
+
+  template <int dim>
+  double
+  ErrorEstimator<dim>::boundary_data_part(const DoFHandler<dim> &dof_handler,
+                                          const VectorType &ghosted_solution,
+                                          const MPI_Comm mpi_communicator) const
+  {
+    const FiniteElement<dim> &fe = *discretization.fe;
+    const Quadrature<dim - 1> quadrature =
+      fe.reference_cell().is_simplex() ?
+        Quadrature<dim - 1>(QGaussSimplex<dim - 1>(3)) :
+        Quadrature<dim - 1>(QGauss<dim - 1>(3));
+    FEFaceValues<dim>           face_values(*discretization.mapping,
+                                  fe,
+                                  quadrature,
+                                  update_values | update_quadrature_points |
+                                    update_JxW_values);
+    std::vector<Vector<double>> u(quadrature.size(), Vector<double>(2)),
+      g(quadrature.size(), Vector<double>(2));
+    double sum = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned() && cell->at_boundary())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->at_boundary(f))
+            {
+              face_values.reinit(cell, f);
+              face_values.get_function_values(ghosted_solution, u);
+              data.boundary_values().vector_value_list(
+                face_values.get_quadrature_points(), g);
+              double integral = 0;
+              for (const unsigned int q :
+                   face_values.quadrature_point_indices())
+                for (unsigned int i = 0; i < 2; ++i)
+                  integral += data.mu[i] * std::pow(g[q][i] - u[q][i], 2) *
+                              face_values.JxW(q);
+              sum += integral / cell->face(f)->measure();
+            }
+    return std::sqrt(Utilities::MPI::sum(sum, mpi_communicator));
   }
 
 

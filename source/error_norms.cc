@@ -16,15 +16,15 @@ namespace membranes
 
   template <int dim>
   typename ErrorNorms<dim>::Errors
-  ErrorNorms<dim>::compute(const DoFHandler<dim>         &dof_handler,
-                           const VectorType              &ghosted_solution,
-                           const FluxReconstruction<dim> &flux_reconstruction,
-                           const MPI_Comm mpi_communicator) const
+  ErrorNorms<dim>::compute(const DoFHandler<dim>     &dof_handler,
+                           const VectorType          &ghosted_solution,
+                           const DiscreteAction<dim> &action,
+                           const MPI_Comm             mpi_communicator) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     FEValues<dim>             fe_values(*discretization.mapping,
                             fe,
-                            flux_reconstruction.dual_quadrature().quadrature(),
+                            action.dual_quadrature().quadrature(),
                             update_values | update_gradients |
                               update_quadrature_points | update_JxW_values);
     const unsigned int        n_q_points = fe_values.n_quadrature_points;
@@ -50,7 +50,7 @@ namespace membranes
           cell->get_dof_values(ghosted_solution,
                                local_dofs.begin(),
                                local_dofs.end());
-          flux_reconstruction.lambda_h_values(cell, lambda_h, &in_omega_h);
+          action.lambda_h_values(cell, lambda_h, &in_omega_h);
           data.set_gradient_step(1e-4 * cell->diameter());
           const auto &points = fe_values.get_quadrature_points();
           for (unsigned int i = 0; i < 2; ++i)

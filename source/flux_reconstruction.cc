@@ -3,238 +3,17 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/lac/full_matrix.h>
-#include <deal.II/lac/lapack_full_matrix.h>
-#include <map>
 #include <membranes/flux_reconstruction.h>
-#include <tuple>
 #include <unordered_map>
+
+// The fluxes t_ih of (4.13) and the identities (4.17), (4.18) and Lemma 17,
+// the evaluation of σ_ih, and the dual mesh as output; the patch
+// equilibration of σ_ih is in flux_equilibration.cc.
 
 namespace membranes
 {
-  template <int dim>
-  DualCellQuadrature<dim>::DualCellQuadrature(
-    const ReferenceCell &reference_cell,
-    const unsigned int   degree)
-  {
-    static_assert(dim == 2, "The dual mesh is implemented for dim = 2.");
-    const unsigned int n_vertices = reference_cell.n_vertices();
-
-    std::vector<Point<dim>> vertices(n_vertices);
-    Point<dim>              barycentre;
-    for (unsigned int v = 0; v < n_vertices; ++v)
-      {
-        vertices[v] = reference_cell.template vertex<dim>(v);
-        barycentre += vertices[v] / n_vertices;
-      }
-
-    // Every edge (face in 2d) of the reference cell contributes the
-    // triangles (a, m_e, b) for both of its end points a.
-    for (const unsigned int e : reference_cell.face_indices())
-      for (unsigned int end = 0; end < 2; ++end)
-        {
-          const unsigned int a =
-            reference_cell.face_to_cell_vertices(e, end, 1);
-          const unsigned int other =
-            reference_cell.face_to_cell_vertices(e, 1 - end, 1);
-          SubTriangle triangle;
-          triangle.vertex  = a;
-          triangle.face    = e;
-          triangle.corners = {
-            {vertices[a], (vertices[a] + vertices[other]) / 2, barycentre}};
-          const Tensor<1, dim> edge_1 = triangle.corners[1] - vertices[a];
-          const Tensor<1, dim> edge_2 = triangle.corners[2] - vertices[a];
-          triangle.area =
-            std::abs(edge_1[0] * edge_2[1] - edge_1[1] * edge_2[0]) / 2;
-          for (unsigned int j = 0; j < 3; ++j)
-            {
-              const Point<dim> &p      = triangle.corners[(j + 1) % 3];
-              const Point<dim> &q      = triangle.corners[(j + 2) % 3];
-              Tensor<1, dim>    normal = cross_product_2d(q - p);
-              normal /= normal.norm();
-              if (normal * (p - triangle.corners[j]) < 0)
-                normal *= -1;
-              triangle.normals[j] = normal;
-            }
-          triangles.push_back(triangle);
-        }
-
-    const QGaussSimplex<dim> simplex_rule((degree + 2) / 2);
-    std::vector<Point<dim>>  points;
-    std::vector<double>      weights;
-    for (unsigned int s = 0; s < triangles.size(); ++s)
-      {
-        const auto &corners = triangles[s].corners;
-        for (unsigned int q = 0; q < simplex_rule.size(); ++q)
-          {
-            const Point<dim> &xi = simplex_rule.point(q);
-            points.push_back(corners[0] + xi[0] * (corners[1] - corners[0]) +
-                             xi[1] * (corners[2] - corners[0]));
-            weights.push_back(simplex_rule.weight(q) * 2 * triangles[s].area);
-            triangle_of_points.push_back(s);
-          }
-      }
-    rule = Quadrature<dim>(points, weights);
-  }
-
-
-
-  template <int dim>
-  const Quadrature<dim> &
-  DualCellQuadrature<dim>::quadrature() const
-  {
-    return rule;
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  DualCellQuadrature<dim>::vertex_of_point(const unsigned int q) const
-  {
-    return triangles[triangle_of_points[q]].vertex;
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  DualCellQuadrature<dim>::sub_triangle_of_point(const unsigned int q) const
-  {
-    return triangle_of_points[q];
-  }
-
-
-
-  template <int dim>
-  const std::vector<typename DualCellQuadrature<dim>::SubTriangle> &
-  DualCellQuadrature<dim>::sub_triangles() const
-  {
-    return triangles;
-  }
-
-
-
   namespace
   {
-    /**
-     * Overwrite the lower triangle of the symmetric matrix @p L with its
-     * Cholesky factor (L Lᵀ = the matrix). Returns false if a pivot is not
-     * positive relative to the diagonal entry.
-     */
-    bool
-    cholesky_factorize(FullMatrix<double> &L)
-    {
-      const unsigned int n = L.m();
-      for (unsigned int j = 0; j < n; ++j)
-        {
-          double d = L(j, j);
-          for (unsigned int k = 0; k < j; ++k)
-            d -= L(j, k) * L(j, k);
-          if (!(d > 1e-14 * std::abs(L(j, j))))
-            return false;
-          L(j, j) = std::sqrt(d);
-          for (unsigned int i = j + 1; i < n; ++i)
-            {
-              for (unsigned int k = 0; k < j; ++k)
-                L(i, j) -= L(i, k) * L(j, k);
-              L(i, j) /= L(j, j);
-            }
-        }
-      return true;
-    }
-
-
-
-    /** Overwrite @p v with (L Lᵀ)⁻¹ v for the Cholesky factor @p L. */
-    void
-    cholesky_solve(const FullMatrix<double> &L, double *v)
-    {
-      const unsigned int n = L.m();
-      for (unsigned int i = 0; i < n; ++i)
-        {
-          for (unsigned int k = 0; k < i; ++k)
-            v[i] -= L(i, k) * v[k];
-          v[i] /= L(i, i);
-        }
-      for (unsigned int i = n; i-- > 0;)
-        {
-          for (unsigned int k = i + 1; k < n; ++k)
-            v[i] -= L(k, i) * v[k];
-          v[i] /= L(i, i);
-        }
-    }
-
-
-
-    /** The work arrays of solve_saddle_point(). */
-    struct SaddlePointScratch
-    {
-      FullMatrix<double>  L, S;
-      std::vector<double> Z, y;
-    };
-
-
-
-    /**
-     * Solve the saddle point system [A Bᵀ; B 0] (x; y) = (b; c) with
-     * A (n × n) symmetric positive definite and B (n_c × n) of full rank,
-     * given as the m × m matrix @p K, m = n + n_c, for two right-hand sides
-     * @p rhs (overwritten with the solutions): by the Cholesky factors of
-     * A and of the Schur complement S = B A⁻¹ Bᵀ. Returns false if a
-     * pivot is not positive (the system is then left to an LU solver).
-     */
-    bool
-    solve_saddle_point(const FullMatrix<double>      &K,
-                       const unsigned int             n,
-                       std::array<Vector<double>, 2> &rhs,
-                       SaddlePointScratch            &scratch)
-    {
-      const unsigned int n_c = K.m() - n;
-      auto &[L, S, Z, y]     = scratch;
-      L.reinit(n, n);
-      L.fill(K, 0, 0, 0, 0);
-      if (!cholesky_factorize(L))
-        return false;
-      // Z = A⁻¹ Bᵀ column by column, S = B Z and its Cholesky factor.
-      Z.resize(n_c * n);
-      for (unsigned int c = 0; c < n_c; ++c)
-        {
-          for (unsigned int i = 0; i < n; ++i)
-            Z[c * n + i] = K(n + c, i);
-          cholesky_solve(L, &Z[c * n]);
-        }
-      S.reinit(n_c, n_c);
-      for (unsigned int c = 0; c < n_c; ++c)
-        for (unsigned int d = 0; d <= c; ++d)
-          for (unsigned int i = 0; i < n; ++i)
-            S(c, d) += K(n + c, i) * Z[d * n + i];
-      if (!cholesky_factorize(S))
-        return false;
-      y.resize(n_c);
-      for (auto &r : rhs)
-        {
-          // x₀ = A⁻¹ b, then S y = B x₀ − c and x = x₀ − Z y.
-          cholesky_solve(L, r.data());
-          for (unsigned int c = 0; c < n_c; ++c)
-            {
-              y[c] = -r[n + c];
-              for (unsigned int i = 0; i < n; ++i)
-                y[c] += K(n + c, i) * r[i];
-            }
-          cholesky_solve(S, y.data());
-          for (unsigned int c = 0; c < n_c; ++c)
-            {
-              r[n + c] = y[c];
-              for (unsigned int i = 0; i < n; ++i)
-                r[i] -= Z[c * n + i] * y[c];
-            }
-        }
-      return true;
-    }
-
-
-
     /** The matrix of a DerivativeForm, for the Piola transform. */
     template <int dim>
     Tensor<2, dim>
@@ -352,11 +131,12 @@ namespace membranes
   template <int dim>
   FluxReconstruction<dim>::FluxReconstruction(
     const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data)
+    const ProblemData<dim>    &data,
+    const DiscreteAction<dim> &action)
     : discretization(discretization)
     , data(data)
-    , dual_cell_quadrature(discretization.fe->reference_cell(), 2)
-    , lambda_h(nullptr)
+    , action(action)
+    , dual_cell_quadrature(action.dual_quadrature())
   {
     // The hat functions of the cell's vertices at the Gauss points of the
     // edges of the sub-triangles (reference values).
@@ -398,82 +178,6 @@ namespace membranes
 
 
   template <int dim>
-  const DualCellQuadrature<dim> &
-  FluxReconstruction<dim>::dual_quadrature() const
-  {
-    return dual_cell_quadrature;
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::set_lambda_h(const DoFHandler<dim> &dof_handler,
-                                        const VectorType      &lambda_h,
-                                        const IndexSet &dual_mesh_vertices)
-  {
-    this->dof_handler        = &dof_handler;
-    this->lambda_h           = &lambda_h;
-    this->dual_mesh_vertices = dual_mesh_vertices;
-  }
-
-
-
-  template <int dim>
-  double
-  FluxReconstruction<dim>::lambda_h_value(const CellIterator &cell,
-                                          const unsigned int  v) const
-  {
-    const types::global_dof_index a = cell->vertex_dof_index(v, 0);
-    return dual_mesh_vertices.is_element(a) ? (*lambda_h)[a] : 0.;
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::lambda_h_values(const CellIterator  &cell,
-                                           std::vector<double> &values,
-                                           std::vector<bool> *in_omega_h) const
-  {
-    // λ_h is constant on the pieces of each vertex: look it up once per
-    // vertex, not once per point.
-    std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
-    std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
-    for (const unsigned int v : cell->vertex_indices())
-      {
-        vertex_values[v] = lambda_h_value(cell, v);
-        vertex_in_omega_h[v] =
-          dual_mesh_vertices.is_element(cell->vertex_dof_index(v, 0));
-      }
-    values.resize(dual_cell_quadrature.quadrature().size());
-    if (in_omega_h)
-      in_omega_h->resize(values.size());
-    for (unsigned int q = 0; q < values.size(); ++q)
-      {
-        const unsigned int v = dual_cell_quadrature.vertex_of_point(q);
-        values[q]            = vertex_values[v];
-        if (in_omega_h)
-          (*in_omega_h)[q] = vertex_in_omega_h[v];
-      }
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::nodal_lambda_values(
-    const FEValues<dim> &fe_values,
-    std::vector<double> &values) const
-  {
-    values.resize(fe_values.n_quadrature_points);
-    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(*lambda_h,
-                                                                 values);
-  }
-
-
-
-  template <int dim>
   Tensor<1, dim>
   FluxReconstruction<dim>::reference_flux(const unsigned int           s,
                                           const std::array<double, 3> &fluxes,
@@ -493,12 +197,13 @@ namespace membranes
   template <int dim>
   void
   FluxReconstruction<dim>::reconstruct(
+    const DoFHandler<dim>           &dof_handler,
     const VectorType                &ghosted_solution,
     const AffineConstraints<double> &hanging_node_constraints,
-    const DiscreteAction<dim>       &action,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator)
   {
+    this->dof_handler                   = &dof_handler;
     const FiniteElement<dim> &fe        = *discretization.fe;
     const auto               &triangles = dual_cell_quadrature.sub_triangles();
     const unsigned int        n_triangles = triangles.size();
@@ -530,7 +235,7 @@ namespace membranes
     std::vector<double>     load(points.n_volume);
 
     const unsigned int n_cells =
-      dof_handler->get_triangulation().n_active_cells();
+      dof_handler.get_triangulation().n_active_cells();
     sub_triangle_data.assign(n_cells * n_triangles, SubTriangleData());
     std::unordered_map<unsigned long long, unsigned int> free_flux_index;
     std::vector<FreeFlux<dim>>                           free_fluxes;
@@ -547,7 +252,7 @@ namespace membranes
     // as on one process, without communication. (At the outer rim of the
     // ghost layer, groups are cut short by artificial cells; they belong
     // to no owned cell.) The patch problems need the owned cells only.
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
@@ -726,7 +431,7 @@ namespace membranes
         }
 
     // The minimizers: the fluxes through the half-edges.
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
@@ -755,7 +460,7 @@ namespace membranes
       local_divergence(dofs_per_cell), local_load_on_pieces(dofs_per_cell),
       local_load_on_hats(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell->get_dof_indices(dof_indices);
@@ -860,567 +565,6 @@ namespace membranes
 
 
 
-  namespace
-  {
-    /**
-     * The record of one sub-triangle κ of a cell K in the support of a
-     * condensed hat function φ_a: what the patch problem of a needs of κ,
-     * with φ_a's coefficients on K applied. The process that owns K writes
-     * it; the process that owns a solves the patch problem (in general
-     * another process: the support of a condensed φ_a can reach beyond the
-     * ghost layer of a process that owns one of its cells). Records are
-     * arrays of doubles, so that they travel in MPI messages as they are.
-     */
-    namespace PatchRecord
-    {
-      enum Entry : unsigned int
-      {
-        /** The key of the unknown flux through edge 2 (a point, x and y). */
-        key_x,
-        key_y,
-        /** Outward flux of κ through edge 2 = factor × the unknown. */
-        factor,
-        /** 1 if edge 2 lies on ∂ω, 0 otherwise. */
-        on_boundary,
-        /** (ψ_k, ψ_l)_κ for k ≤ l: six entries. */
-        gram,
-        area = gram + 6,
-        /** ∫_κ (f_i φ_a − μ_i ∇u_ih·∇φ_a), i = 1, 2. */
-        residual,
-        /** ∫_κ φ_a. */
-        mass = residual + 2,
-        /** ∫_e −μ_i φ_a ∇u_ih·n through edge e of κ: 3 per i. */
-        edge_flux,
-        /** ∫ φ_a along edge 2 if it lies on ∂ω. */
-        boundary_mass = edge_flux + 6,
-        /** The number of entries. */
-        size
-      };
-    } // namespace PatchRecord
-
-
-
-    /** A half-edge of a patch problem, by its key, for sorting. */
-    struct PatchKey
-    {
-      double       x, y;
-      unsigned int cell, s;
-    };
-  } // namespace
-
-
-
-  /**
-   * The work arrays of solve_patch_problem(), kept from one patch to the
-   * next.
-   */
-  template <int dim>
-  struct FluxReconstruction<dim>::PatchScratch
-  {
-    std::vector<PatchKey>                             keys;
-    std::vector<std::pair<unsigned int, double>>      unknown_of;
-    std::vector<std::array<double, 2>>                source, known, mean;
-    std::vector<double>                               weight;
-    std::vector<std::array<std::array<double, 3>, 2>> target;
-    FullMatrix<double>                                matrix;
-    std::array<Vector<double>, 2>                     rhs;
-    SaddlePointScratch                                saddle_point;
-  };
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::write_patch_record(
-    const CellIterator            &cell,
-    const std::array<double, 4>   &coefficients,
-    const std::vector<PatchTerms> &patch_terms,
-    double                        *record) const
-  {
-    using namespace PatchRecord;
-    const unsigned int n_triangles =
-      dual_cell_quadrature.sub_triangles().size();
-    for (unsigned int j = 0; j < ring.size(); ++j, record += size)
-      {
-        const unsigned int id =
-          cell->active_cell_index() * n_triangles + ring[j];
-        const SubTriangleData &kappa = sub_triangle_data[id];
-        const PatchTerms      &terms = patch_terms[id];
-
-        record[key_x]               = terms.key[0];
-        record[key_y]               = terms.key[1];
-        record[PatchRecord::factor] = terms.factor;
-        record[on_boundary]         = terms.on_boundary ? 1 : 0;
-        for (unsigned int k = 0, n = 0; k < 3; ++k)
-          for (unsigned int l = k; l < 3; ++l, ++n)
-            record[gram + n] = kappa.gram[k][l];
-        record[area] = kappa.area;
-
-        record[residual]      = 0;
-        record[residual + 1]  = 0;
-        record[mass]          = 0;
-        record[boundary_mass] = 0;
-        for (unsigned int n = 0; n < 6; ++n)
-          record[edge_flux + n] = 0;
-        for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell; ++v)
-          if (coefficients[v] != 0)
-            {
-              record[mass] += coefficients[v] * terms.hat_mass[v];
-              for (unsigned int i = 0; i < 2; ++i)
-                record[residual + i] +=
-                  coefficients[v] * terms.hat_residual[i][v];
-            }
-        // φ_a at the Gauss points of the edges of κ.
-        for (unsigned int e = 0; e < 3; ++e)
-          for (unsigned int k = 0; k < 2; ++k)
-            {
-              double phi = 0;
-              for (unsigned int v = 0; v < GeometryInfo<dim>::vertices_per_cell;
-                   ++v)
-                phi +=
-                  coefficients[v] *
-                  edge_shape_values[((ring[j] * 3 + e) * 2 + k) *
-                                      GeometryInfo<dim>::vertices_per_cell +
-                                    v];
-              for (unsigned int i = 0; i < 2; ++i)
-                record[edge_flux + 3 * i + e] -= phi * terms.edge_flux[i][e][k];
-              if (e == 2)
-                record[boundary_mass] += phi * terms.boundary_length[k];
-            }
-      }
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::equilibrate(
-    const std::vector<PatchTerms>   &patch_terms,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const IndexSet                  &locally_owned_dofs,
-    const MPI_Comm                   mpi_communicator)
-  {
-    const unsigned int n_ring      = ring.size();
-    const unsigned int record_size = n_ring * PatchRecord::size;
-    const unsigned int result_size = n_ring * 6;
-
-    // The owned cells of the support of each condensed φ_a, with the
-    // coefficients of φ_a in the hat functions of the cell's vertices (1
-    // at a, the constraint weight at a hanging vertex with parent a): in
-    // local_patches if this process owns a, else to be sent to a's owner.
-    using Coefficients =
-      std::array<double, GeometryInfo<dim>::vertices_per_cell>;
-    std::map<types::global_dof_index,
-             std::vector<std::pair<CellIterator, Coefficients>>>
-      local_patches;
-    std::vector<std::tuple<CellIterator, types::global_dof_index, Coefficients>>
-                                         remote;
-    std::vector<types::global_dof_index> remote_vertices;
-    for (const auto &cell : dof_handler->active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          std::map<types::global_dof_index, Coefficients> of_cell;
-          for (const unsigned int v : cell->vertex_indices())
-            {
-              const auto dof = cell->vertex_dof_index(v, 0);
-              if (const auto *entries =
-                    hanging_node_constraints.get_constraint_entries(dof))
-                for (const auto &[parent, weight] : *entries)
-                  of_cell[parent][v] += weight;
-              else
-                of_cell[dof][v] += 1;
-            }
-          for (const auto &[a, coefficients] : of_cell)
-            if (locally_owned_dofs.is_element(a))
-              local_patches[a].emplace_back(cell, coefficients);
-            else
-              {
-                remote.emplace_back(cell, a, coefficients);
-                remote_vertices.push_back(a);
-              }
-        }
-    std::sort(remote_vertices.begin(), remote_vertices.end());
-    IndexSet remote_set(locally_owned_dofs.size());
-    remote_set.add_indices(remote_vertices.begin(),
-                           std::unique(remote_vertices.begin(),
-                                       remote_vertices.end()));
-    const std::vector<unsigned int> owners =
-      Utilities::MPI::compute_index_owner(locally_owned_dofs,
-                                          remote_set,
-                                          mpi_communicator);
-    std::map<unsigned int, std::vector<double>>       records;
-    std::map<unsigned int, std::vector<CellIterator>> sent;
-    for (const auto &[cell, a, coefficients] : remote)
-      {
-        const unsigned int   owner  = owners[remote_set.index_within_set(a)];
-        std::vector<double> &buffer = records[owner];
-        buffer.push_back(a);
-        buffer.resize(buffer.size() + record_size);
-        write_patch_record(cell,
-                           coefficients,
-                           patch_terms,
-                           buffer.data() + buffer.size() - record_size);
-        sent[owner].push_back(cell);
-      }
-
-    // The records of the owned vertices from other processes, and the
-    // buffers for the answers: σ_ih^a on their sub-triangles.
-    const std::map<unsigned int, std::vector<double>> received =
-      Utilities::MPI::some_to_some(mpi_communicator, records);
-    std::map<types::global_dof_index,
-             std::vector<std::pair<unsigned int, unsigned int>>>
-                                                remote_members;
-    std::map<unsigned int, std::vector<double>> replies;
-    for (const auto &[process, buffer] : received)
-      {
-        const unsigned int n_records = buffer.size() / (1 + record_size);
-        replies[process].assign(n_records * result_size, 0.);
-        for (unsigned int r = 0; r < n_records; ++r)
-          remote_members[static_cast<types::global_dof_index>(
-                           buffer[r * (1 + record_size)])]
-            .emplace_back(process, r);
-      }
-
-    // The patch problems, σ_ih = Σ_a σ_ih^a on the owned cells.
-    for (auto &kappa : sub_triangle_data)
-      kappa.equilibrated = {};
-    PatchScratch                scratch;
-    std::vector<double>         local_records, local_results;
-    std::vector<const double *> patch;
-    std::vector<double *>       result;
-    for (const auto &[a, cells] : local_patches)
-      {
-        local_records.resize(cells.size() * record_size);
-        local_results.assign(cells.size() * result_size, 0.);
-        patch.clear();
-        result.clear();
-        for (unsigned int c = 0; c < cells.size(); ++c)
-          {
-            write_patch_record(cells[c].first,
-                               cells[c].second,
-                               patch_terms,
-                               local_records.data() + c * record_size);
-            patch.push_back(local_records.data() + c * record_size);
-            result.push_back(local_results.data() + c * result_size);
-          }
-        if (const auto members = remote_members.find(a);
-            members != remote_members.end())
-          for (const auto &[process, r] : members->second)
-            {
-              patch.push_back(received.at(process).data() +
-                              r * (1 + record_size) + 1);
-              result.push_back(replies[process].data() + r * result_size);
-            }
-        solve_patch_problem(a, patch, result, scratch);
-        for (unsigned int c = 0; c < cells.size(); ++c)
-          add_patch_result(cells[c].first,
-                           local_results.data() + c * result_size);
-      }
-    for (const auto &[process, buffer] :
-         Utilities::MPI::some_to_some(mpi_communicator, replies))
-      for (unsigned int r = 0; r < sent[process].size(); ++r)
-        add_patch_result(sent[process][r], buffer.data() + r * result_size);
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::add_patch_result(const CellIterator &cell,
-                                            const double       *result)
-  {
-    const unsigned int n_triangles =
-      dual_cell_quadrature.sub_triangles().size();
-    for (unsigned int j = 0; j < ring.size(); ++j)
-      for (unsigned int i = 0; i < 2; ++i)
-        for (unsigned int e = 0; e < 3; ++e)
-          sub_triangle_data[cell->active_cell_index() * n_triangles + ring[j]]
-            .equilibrated[i][e] += result[6 * j + 3 * i + e];
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::solve_patch_problem(
-    const types::global_dof_index      a,
-    const std::vector<const double *> &patch,
-    const std::vector<double *>       &result,
-    PatchScratch                      &scratch) const
-  {
-    using namespace PatchRecord;
-    const unsigned int          n_ring  = ring.size();
-    const unsigned int          n_cells = patch.size();
-    const unsigned int          n_sub   = n_cells * n_ring;
-    const unsigned int          invalid = numbers::invalid_unsigned_int;
-    const std::array<double, 2> sign{{1., -1.}};
-    // Entry k of the record of sub-triangle ring[j] of cell c; s = c n_ring +
-    // j.
-    const auto entry = [&](const unsigned int s, const unsigned int k) {
-      return patch[s / n_ring][(s % n_ring) * size + k];
-    };
-    const double lambda_a =
-      dual_mesh_vertices.is_element(a) ? (*lambda_h)[a] : 0.;
-
-    // The unknown fluxes: through the half-edges (or small edges at a
-    // hanging node) that two cells of the patch share, found by their
-    // keys. unknown_of[s]: the unknown of the half-edge of sub-triangle s
-    // and the factor that gives its outward flux, or none: on ∂ω the flux
-    // is prescribed, on the rest of the boundary of the support of φ_a it
-    // is zero.
-    auto &keys = scratch.keys;
-    keys.clear();
-    for (unsigned int s = 0; s < n_sub; ++s)
-      if (entry(s, on_boundary) == 0)
-        keys.push_back({entry(s, key_x), entry(s, key_y), s / n_ring, s});
-    std::sort(keys.begin(), keys.end(), [](const auto &p, const auto &q) {
-      return std::tie(p.x, p.y, p.cell) < std::tie(q.x, q.y, q.cell);
-    });
-    auto &unknown_of = scratch.unknown_of;
-    unknown_of.assign(n_sub, {invalid, 0.});
-    unsigned int n_x = 0;
-    for (unsigned int begin = 0, end; begin < keys.size(); begin = end)
-      {
-        for (end = begin + 1;
-             end < keys.size() && keys[end].x == keys[begin].x &&
-             keys[end].y == keys[begin].y;
-             ++end)
-          ;
-        if (keys[end - 1].cell != keys[begin].cell)
-          {
-            for (unsigned int k = begin; k < end; ++k)
-              unknown_of[keys[k].s] = {n_x, entry(keys[k].s, factor)};
-            ++n_x;
-          }
-      }
-
-    // The divergence of σ_ih^a on each sub-triangle, ∫_κ r_ia with
-    // r_ia = (f_i + s_i λ_a) φ_a − μ_i ∇u_ih·∇φ_a, and the prescribed
-    // fluxes β through ∂ω: those of −μ_i φ_a ∇u_ih, plus what ∫ r_ia
-    // leaves over, spread in proportion to ∫ φ_a on each half-edge. Around
-    // an interior vertex, ∫ r_ia = 0 is (4.5) for the condensed φ_a; what
-    // quadrature and the linear solver leave of it is spread as a constant
-    // instead.
-    auto &source = scratch.source;
-    auto &known  = scratch.known;
-    source.assign(n_sub, {});
-    known.assign(n_sub, {});
-    std::array<double, 2> total{}, total_boundary_flux{};
-    double                patch_area = 0, total_boundary_mass = 0;
-    for (unsigned int s = 0; s < n_sub; ++s)
-      {
-        patch_area += entry(s, area);
-        total_boundary_mass += entry(s, boundary_mass);
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            source[s][i] =
-              entry(s, residual + i) + sign[i] * lambda_a * entry(s, mass);
-            total[i] += source[s][i];
-            if (entry(s, on_boundary) != 0)
-              {
-                known[s][i] = entry(s, edge_flux + 3 * i + 2);
-                total_boundary_flux[i] += known[s][i];
-              }
-          }
-      }
-    for (unsigned int s = 0; s < n_sub; ++s)
-      for (unsigned int i = 0; i < 2; ++i)
-        if (total_boundary_mass > 0)
-          known[s][i] += (total[i] - total_boundary_flux[i]) *
-                         entry(s, boundary_mass) / total_boundary_mass;
-        else
-          source[s][i] -= total[i] * entry(s, area) / patch_area;
-
-    // The target: on each sub-triangle the RT0 field with the fluxes of
-    // −μ_i φ_a ∇u_ih through its edges; through a half-edge shared by two
-    // cells, the mean of both sides. The targets are then conforming, and
-    // where u_ih is linear they satisfy the constraints: σ_ih^a is its
-    // target, and σ_ih = −μ_i ∇u_ih.
-    auto &target = scratch.target;
-    target.resize(n_sub);
-    {
-      auto &mean   = scratch.mean;
-      auto &weight = scratch.weight;
-      mean.assign(n_x, {});
-      weight.assign(n_x, 0.);
-      for (unsigned int s = 0; s < n_sub; ++s)
-        {
-          for (unsigned int i = 0; i < 2; ++i)
-            for (unsigned int e = 0; e < 3; ++e)
-              target[s][i][e] = entry(s, edge_flux + 3 * i + e);
-          if (const auto [x, f] = unknown_of[s]; x != invalid)
-            {
-              weight[x] += std::abs(f);
-              for (unsigned int i = 0; i < 2; ++i)
-                mean[x][i] += (f > 0 ? 1. : -1.) * target[s][i][2];
-            }
-        }
-      for (unsigned int s = 0; s < n_sub; ++s)
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            const auto [x, f] = unknown_of[s];
-            target[s][i][2] =
-              (x != invalid ? f * mean[x][i] / weight[x] : known[s][i]);
-          }
-    }
-
-    // On cell c, with the outward fluxes b_j through the half-edges of its
-    // ring and its circulation z_c, the flux from ring[j] into ring[j+1]
-    // is z_c + Σ_{k≤j} (r_k − b_k), so that div = r_j on every κ; the
-    // ring closes iff Σ_j b_j = Σ_j r_j, the cell's constraint (one of
-    // them is redundant: together they say ∫ r_ia = flux through ∂ω).
-    // Edge 2 of ring[j] is its half-edge, through edge j % 2 (out) it
-    // meets ring[j+1], through the other (in) ring[j−1]. With
-    // w_j = Σ_{k<j} b_k − z_c, its fluxes are
-    //
-    //   F_j = w_j D + b_j E + q_j,  D = e_in − e_out,  E = e_2 − e_out,
-    //
-    // q_j = (Σ_{k≤j} r_k) e_out − (Σ_{k<j} r_k) e_in, and the patch
-    // problem minimizes Σ_κ (F_κ − target_κ)ᵀ G_κ (F_κ − target_κ) under
-    // the constraints. On each cell the quadratic form in (b_0, …, z_c)
-    // has entries from suffix sums of DᵀG_jD, so it costs O(n_ring²).
-    // An unknown b_j is factor × a flux unknown of the patch; a prescribed
-    // one goes to the right-hand side.
-    const unsigned int n_constraints = n_cells - 1;
-    const unsigned int m             = n_x + n_cells + n_constraints;
-    const unsigned int n_local       = n_ring + 1; // b_0, …, b_{n-1}, z
-    auto              &matrix        = scratch.matrix;
-    auto              &rhs           = scratch.rhs;
-    matrix.reinit(m, m);
-    for (auto &r : rhs)
-      r.reinit(m);
-    // Per cell, on the stack (a ring has at most 8 sub-triangles).
-    constexpr unsigned int max_local = 9;
-    AssertIndexRange(n_local, max_local + 1);
-    double                                       M[max_local][max_local];
-    std::array<std::array<double, 2>, max_local> l, rho, sigma;
-    std::array<double, max_local>                alpha, gamma, epsilon, suffix;
-    std::array<std::pair<unsigned int, double>, max_local> global;
-    for (unsigned int c = 0; c < n_cells; ++c)
-      {
-        std::array<double, 2> partial{}, known_total{};
-        for (unsigned int j = 0; j < n_ring; ++j)
-          {
-            const unsigned int s   = c * n_ring + j;
-            const unsigned int out = j % 2, in = 1 - out;
-            const double      *g       = patch[c] + j * size + gram;
-            const double       G[3][3] = {{g[0], g[1], g[2]},
-                                          {g[1], g[3], g[4]},
-                                          {g[2], g[4], g[5]}};
-            alpha[j]   = G[in][in] - 2 * G[in][out] + G[out][out];
-            gamma[j]   = G[in][2] - G[in][out] - G[out][2] + G[out][out];
-            epsilon[j] = G[2][2] - 2 * G[2][out] + G[out][out];
-            for (unsigned int i = 0; i < 2; ++i)
-              {
-                std::array<double, 3> r{};
-                r[out] = partial[i] + source[s][i];
-                r[in]  = -partial[i];
-                for (unsigned int e = 0; e < 3; ++e)
-                  r[e] -= target[s][i][e];
-                std::array<double, 3> Gr{};
-                for (unsigned int e = 0; e < 3; ++e)
-                  for (unsigned int f = 0; f < 3; ++f)
-                    Gr[e] += G[e][f] * r[f];
-                rho[j][i]   = Gr[in] - Gr[out];
-                sigma[j][i] = Gr[2] - Gr[out];
-                partial[i] += source[s][i];
-                known_total[i] += known[s][i];
-              }
-          }
-        suffix[n_ring] = 0;
-        for (unsigned int j = n_ring; j-- > 0;)
-          suffix[j] = suffix[j + 1] + alpha[j];
-        const unsigned int z = n_ring;
-        for (unsigned int k = 0; k < n_ring; ++k)
-          {
-            for (unsigned int j = 0; j < n_ring; ++j)
-              M[k][j] = suffix[std::max(k, j) + 1];
-            M[k][k] += epsilon[k];
-            M[k][z] = M[z][k] = -suffix[k + 1] - gamma[k];
-            for (unsigned int j = 0; j < k; ++j)
-              {
-                M[j][k] += gamma[k];
-                M[k][j] += gamma[k];
-              }
-          }
-        M[z][z] = suffix[0];
-        std::array<double, 2> rho_suffix{};
-        for (unsigned int k = n_ring; k-- > 0;)
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              l[k][i] = rho_suffix[i] + sigma[k][i];
-              rho_suffix[i] += rho[k][i];
-            }
-        for (unsigned int i = 0; i < 2; ++i)
-          l[z][i] = -rho_suffix[i];
-
-        for (unsigned int k = 0; k < n_ring; ++k)
-          global[k] = unknown_of[c * n_ring + k];
-        global[z] = {n_x + c, 1.};
-        for (unsigned int u = 0; u < n_local; ++u)
-          if (global[u].first != invalid)
-            {
-              std::array<double, 2> linear = l[u];
-              for (unsigned int v = 0; v < n_local; ++v)
-                if (global[v].first != invalid)
-                  matrix(global[u].first, global[v].first) +=
-                    global[u].second * M[u][v] * global[v].second;
-                else
-                  for (unsigned int i = 0; i < 2; ++i)
-                    linear[i] += M[u][v] * known[c * n_ring + v][i];
-              for (unsigned int i = 0; i < 2; ++i)
-                rhs[i](global[u].first) -= global[u].second * linear[i];
-            }
-        if (c < n_constraints)
-          {
-            const unsigned int row = n_x + n_cells + c;
-            for (unsigned int j = 0; j < n_ring; ++j)
-              if (const auto [x, f] = global[j]; x != invalid)
-                {
-                  matrix(row, x) += f;
-                  matrix(x, row) += f;
-                }
-            for (unsigned int i = 0; i < 2; ++i)
-              rhs[i](row) = partial[i] - known_total[i];
-          }
-      }
-
-    // The matrix of the minimization is positive definite, so that the
-    // Cholesky factors of it and of the Schur complement of the
-    // constraints solve the system; should round-off spoil that on a
-    // degenerate patch, LU with pivoting does.
-    if (!solve_saddle_point(matrix, n_x + n_cells, rhs, scratch.saddle_point))
-      {
-        LAPACKFullMatrix<double> lu(m, m);
-        lu = matrix;
-        lu.compute_lu_factorization();
-        for (unsigned int i = 0; i < 2; ++i)
-          lu.solve(rhs[i]);
-      }
-
-    // σ_ih^a on the sub-triangles of the patch.
-    for (unsigned int c = 0; c < n_cells; ++c)
-      for (unsigned int i = 0; i < 2; ++i)
-        {
-          double partial = 0, w = -rhs[i](n_x + c);
-          for (unsigned int j = 0; j < n_ring; ++j)
-            {
-              const unsigned int s   = c * n_ring + j;
-              const unsigned int out = j % 2, in = 1 - out;
-              const auto [x, f] = unknown_of[s];
-              const double b    = (x != invalid ? f * rhs[i](x) : known[s][i]);
-              double      *F    = result[c] + 6 * j + 3 * i;
-              F[out]            = -w - b + partial + source[s][i];
-              F[in]             = w - partial;
-              F[2]              = b;
-              partial += source[s][i];
-              w += b;
-            }
-        }
-  }
-
-
-
   template <int dim>
   void
   FluxReconstruction<dim>::flux_values(const CellIterator          &cell,
@@ -1511,7 +655,8 @@ namespace membranes
                   const Tensor<2, dim> DF  = to_tensor(fe_values.jacobian(q));
                   const double         det = std::abs(determinant(DF));
                   patch.data(0, j) = cell->vertex_index(triangles[s].vertex);
-                  patch.data(1, j) = lambda_h_value(cell, triangles[s].vertex);
+                  patch.data(1, j) =
+                    action.lambda_h_value(cell, triangles[s].vertex);
                   for (unsigned int i = 0; i < 2; ++i)
                     {
                       const Tensor<1, dim> t =
@@ -1531,6 +676,5 @@ namespace membranes
 
 
 
-  template class DualCellQuadrature<2>;
   template class FluxReconstruction<2>;
 } // namespace membranes

@@ -30,8 +30,8 @@ namespace membranes
                         computing_timer,
                         mpi_communicator)
     , error_norms(discretization, data)
-    , flux_reconstruction(discretization, data)
-    , error_estimator(discretization, data, action)
+    , flux_reconstruction(discretization, data, action)
+    , error_estimator(discretization, data)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
   {}
@@ -294,9 +294,7 @@ namespace membranes
   MembraneProblem<dim>::postprocess()
   {
     compute_lambda_h();
-    flux_reconstruction.set_lambda_h(dof_handler,
-                                     lambda_h,
-                                     action.dual_mesh_vertices());
+    action.set_lambda_h(lambda_h);
 
     double      min_w      = std::numeric_limits<double>::max();
     double      min_lambda = min_w, prop12 = 0, product = 0;
@@ -337,7 +335,7 @@ namespace membranes
       {
         const auto errors    = error_norms.compute(dof_handler,
                                                 ghosted_solution,
-                                                flux_reconstruction,
+                                                action,
                                                 mpi_communicator);
         record.err_u1_H1     = errors.u_H1[0];
         record.err_u2_H1     = errors.u_H1[1];
@@ -353,21 +351,38 @@ namespace membranes
 
 
   /**
-   * The fluxes t_ih of §4.2 and the defects of (4.17), (4.18) and of the
-   * balance of Lemma 17, if the scene asks for the flux reconstruction.
+   * Whether the fluxes are reconstructed: for the flux estimator when it
+   * drives refinement, and when the scene asks for them in the output.
+   */
+  template <int dim>
+  bool
+  MembraneProblem<dim>::computes_fluxes() const
+  {
+    return parameters.refinement.estimator == Parameters::Estimator::flux ||
+           parameters.output.flux_reconstruction;
+  }
+
+
+
+  /**
+   * The fluxes t_ih of §4.2 and σ_ih, if computes_fluxes(); with
+   * `Output/Flux reconstruction`, the defects of (4.17), (4.18) and of the
+   * balance of Lemma 17 for the report.
    */
   template <int dim>
   void
   MembraneProblem<dim>::reconstruct_fluxes()
   {
-    if (!parameters.output.flux_reconstruction)
+    if (!computes_fluxes())
       return;
     TimerOutput::Scope scope(computing_timer, "flux");
-    flux_reconstruction.reconstruct(ghosted_solution,
+    flux_reconstruction.reconstruct(dof_handler,
+                                    ghosted_solution,
                                     hanging_node_constraints,
-                                    action,
                                     locally_owned_dofs,
                                     mpi_communicator);
+    if (!parameters.output.flux_reconstruction)
+      return;
     const auto &identities     = flux_reconstruction.identities();
     record.measure_defect      = identities.measure_defect;
     record.conservation_defect = identities.conservation_defect;
@@ -379,12 +394,11 @@ namespace membranes
   /**
    * The residual estimator η and its indicators η_K², when it drives
    * adaptive refinement or a target estimator, or the exact solution is
-   * known, and the flux
-   * estimator with the flux reconstruction; with the exact solution, their
-   * effectivity indices η / |||e|||. The indicators of `Refinement/Estimator`
-   * are kept for marking. Balanced stopping needs the residual estimator on
-   * every mesh. The time of the flux estimator counts as flux
-   * reconstruction time, the rest as estimator time.
+   * known, and the flux estimator and its parts with the fluxes; with the
+   * exact solution, their effectivity indices η / |||e|||. The indicators
+   * of `Refinement/Estimator` are kept for marking. Balanced stopping needs
+   * the residual estimator on every mesh. The time of the flux estimator
+   * counts as flux reconstruction time, the rest as estimator time.
    */
   template <int dim>
   void
@@ -394,32 +408,44 @@ namespace membranes
                           Parameters::RefinementStrategy::adaptive;
     const bool balanced =
       parameters.solver.stopping == Parameters::Stopping::balanced;
-    const auto driving = parameters.refinement.estimator;
+    const bool flux_drives =
+      parameters.refinement.estimator == Parameters::Estimator::flux;
+    const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
-    for (const auto kind :
-         {Parameters::Estimator::residual, Parameters::Estimator::flux})
+    if ((drives && !flux_drives) || data.exact_solution_known() || balanced)
       {
-        const bool flux = (kind == Parameters::Estimator::flux);
-        const bool drives =
-          driving == kind &&
-          (adaptive || parameters.refinement.target_estimator > 0);
-        if (flux ? !parameters.output.flux_reconstruction :
-                   !drives && !data.exact_solution_known() && !balanced)
-          continue;
-        TimerOutput::Scope scope(computing_timer, flux ? "flux" : "estimate");
-        Vector<double>     kind_indicators;
-        const double       eta = error_estimator.estimate(kind,
-                                                    dof_handler,
-                                                    ghosted_solution,
-                                                    flux_reconstruction,
-                                                    kind_indicators,
-                                                    mpi_communicator);
-        (flux ? record.flux_estimator : record.estimator) = eta;
+        TimerOutput::Scope scope(computing_timer, "estimate");
+        Vector<double>     residual_indicators;
+        record.estimator =
+          error_estimator.residual_estimate(dof_handler,
+                                            ghosted_solution,
+                                            action,
+                                            residual_indicators,
+                                            mpi_communicator);
         if (record.err_energy)
-          (flux ? record.flux_effectivity : record.effectivity) =
-            eta / *record.err_energy;
-        if (kind == driving)
-          indicators.swap(kind_indicators);
+          record.effectivity = *record.estimator / *record.err_energy;
+        if (!flux_drives)
+          indicators.swap(residual_indicators);
+      }
+    if (computes_fluxes())
+      {
+        TimerOutput::Scope scope(computing_timer, "flux");
+        Vector<double>     flux_indicators;
+        const auto         estimate = error_estimator.flux_estimate(dof_handler,
+                                                            ghosted_solution,
+                                                            action,
+                                                            flux_reconstruction,
+                                                            flux_indicators,
+                                                            mpi_communicator);
+        record.flux_estimator       = estimate.eta;
+        record.flux_estimator_flux  = estimate.flux;
+        record.flux_estimator_oscillation = estimate.oscillation;
+        record.flux_estimator_contact     = estimate.contact;
+        record.flux_estimator_boundary    = estimate.boundary;
+        if (record.err_energy)
+          record.flux_effectivity = estimate.eta / *record.err_energy;
+        if (flux_drives)
+          indicators.swap(flux_indicators);
       }
   }
 
@@ -616,7 +642,7 @@ namespace membranes
     record.time_solve       = time_of("solve");
     record.time_postprocess = time_of("postprocess");
     record.time_estimate    = time_of("estimate");
-    if (parameters.output.flux_reconstruction)
+    if (computes_fluxes())
       record.time_flux = time_of("flux");
   }
 

@@ -50,7 +50,11 @@ namespace membranes
               r.processes,
               r.memory_mb,
               r.linearization_estimate,
-              r.algebraic_estimate};
+              r.algebraic_estimate,
+              r.flux_estimator_flux,
+              r.flux_estimator_oscillation,
+              r.flux_estimator_contact,
+              r.flux_estimator_boundary};
     }
 
     /** Columns that hold whole numbers. */
@@ -107,7 +111,11 @@ namespace membranes
                                                 "processes",
                                                 "memory_mb",
                                                 "eta_linearization",
-                                                "eta_algebraic"};
+                                                "eta_algebraic",
+                                                "flux_estimator_flux",
+                                                "flux_estimator_oscillation",
+                                                "flux_estimator_contact",
+                                                "flux_estimator_boundary"};
     return names;
   }
 

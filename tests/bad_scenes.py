@@ -60,9 +60,6 @@ CASES = [
          "meshes", "square-triangles.msh"), [], ["Geometry/Cell type"]),
     ("unknown domain",
      "subsection Geometry\n  set Domain = torus\nend\n", [], ["Domain"]),
-    ("flux estimator without the flux reconstruction",
-     "subsection Refinement\n  set Estimator = flux\nend\n", [],
-     ["Refinement/Estimator"]),
     ("coarsening triangles",
      "subsection Geometry\n  set Cell type = triangle\nend\n"
      "subsection Refinement\n  set Strategy = adaptive\n"

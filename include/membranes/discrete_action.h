@@ -4,10 +4,12 @@
 #include <array>
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
+#include <membranes/dual_cell_quadrature.h>
 #include <membranes/problem_data.h>
 #include <utility>
 #include <vector>
@@ -29,8 +31,16 @@ namespace membranes
    *
    * Both right-hand sides are computed; Prop. 12 says that they agree for
    * the solution of the discrete variational inequality (3.4), and
-   * λ_a ≥ 0 and λ_a (u1h − u2h)(a) = 0 (4.8). λ_h is the function equal to
-   * λ_a on the dual cell D_a.
+   * λ_a ≥ 0 and λ_a (u1h − u2h)(a) = 0 (4.8).
+   *
+   * <h3>λ_h</h3>
+   * λ_h is the function equal to λ_a on the dual cell D_a (a ∈ V_h); on the
+   * pieces of a hanging vertex, the constraint-weighted mean of the λ_a of
+   * its parents; zero on the pieces of boundary vertices, the strip ω \ ω_h.
+   * This class is its one home: errors, both estimators, the flux
+   * reconstruction and the output read λ_h through lambda_h_values() on the
+   * pieces of the DualCellQuadrature, or its nodal interpolant through
+   * nodal_lambda_values().
    *
    * The same nodal quantities are the multipliers of the active set solver:
    * λ_a d_a is the residual of membrane 1's equation at a.
@@ -137,6 +147,48 @@ namespace membranes
     void
     fill_nodal_vector(VectorType &lambda_h) const;
 
+    /**
+     * Use @p lambda_h (λ_a in the u1 slot of the vertices of
+     * dual_mesh_vertices(), distributed to the hanging vertices, ghosted)
+     * as λ_h; it must live as long as λ_h is read.
+     */
+    void
+    set_lambda_h(const VectorType &lambda_h);
+
+    /** The quadrature on the pieces K ∩ D_a of every cell. */
+    const DualCellQuadrature<dim> &
+    dual_quadrature() const;
+
+    /** λ_h on the pieces K ∩ D_a of vertex @p v of @p cell. */
+    double
+    lambda_h_value(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                   const unsigned int v) const;
+
+    /**
+     * λ_h on the pieces of the vertex whose u1 DoF is @p a (locally
+     * relevant); zero if a is on ∂ω.
+     */
+    double
+    lambda_h_at_vertex(const types::global_dof_index a) const;
+
+    /**
+     * λ_h at the points of dual_quadrature() on @p cell; with @p in_omega_h,
+     * also whether each point lies in ω_h (not in the strip along ∂ω).
+     */
+    void
+    lambda_h_values(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                    std::vector<double> &values,
+                    std::vector<bool>   *in_omega_h = nullptr) const;
+
+    /**
+     * The P1/Q1 function λ̃_h = Σ_a λ_a φ_a with the nodal values λ_a of
+     * λ_h (zero on ∂ω; at a hanging vertex the constraint-weighted mean),
+     * at the points of @p fe_values, reinit'ed on a cell.
+     */
+    void
+    nodal_lambda_values(const FEValues<dim> &fe_values,
+                        std::vector<double> &values) const;
+
     /** λ_a from membrane i (0 or 1) for the k-th vertex of vertices(). */
     double
     lambda_from_membrane(const unsigned int i, const unsigned int k) const;
@@ -172,8 +224,11 @@ namespace membranes
     force_scale_l2() const;
 
   private:
-    const Discretization<dim> &discretization;
-    const ProblemData<dim>    &data;
+    const Discretization<dim>    &discretization;
+    const ProblemData<dim>       &data;
+    const DualCellQuadrature<dim> dual_cell_quadrature;
+    /** λ_h as given to set_lambda_h(). */
+    const VectorType *lambda_h_vector;
 
     IndexSet locally_owned_dofs;
     MPI_Comm mpi_communicator;

@@ -112,42 +112,67 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
 
     /**
-     * The data enter through @p action: the means and oscillations of the
-     * loads per cell, evaluated once per mesh with the cell loads.
+     * The flux estimator η and its parts, over all processes: η² =
+     * Σ_i (η_F,i + η_R,i)² + 2 B.
      */
+    struct FluxEstimate
+    {
+      double eta = 0;
+      /** (Σ_i η_F,i²)^{1/2}: the distance of σ_ih from −μ_i ∇u_ih. */
+      double flux = 0;
+      /** (Σ_i η_R,i²)^{1/2}: the residual f_i + s_i λ̃_h − div σ_ih. */
+      double oscillation = 0;
+      /** (2 B)^{1/2}: the contact term. */
+      double contact = 0;
+      /**
+       * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
+       * g_2 = g2: the size of the energy of a lifting of the boundary
+       * data error into the cells along ∂ω (constant 1), which the
+       * argument for η assumes to vanish. Not part of η.
+       */
+      double boundary = 0;
+    };
+
     ErrorEstimator(const Discretization<dim> &discretization,
-                   const ProblemData<dim>    &data,
-                   const DiscreteAction<dim> &action);
+                   const ProblemData<dim>    &data);
 
     /**
-     * Fill @p indicators (indexed by active_cell_index(), zero on cells
-     * not locally owned) with the η_K² of estimator @p kind and return η
-     * over all processes, with the λ_h (and for the flux estimator the
-     * fluxes) of @p flux_reconstruction.
+     * The residual estimator: fill @p indicators (indexed by
+     * active_cell_index(), zero on cells not locally owned) with its η_K²
+     * and return η over all processes, with the λ_h of @p action.
      */
     double
-    estimate(const Parameters::Estimator    kind,
-             const DoFHandler<dim>         &dof_handler,
-             const VectorType              &ghosted_solution,
-             const FluxReconstruction<dim> &flux_reconstruction,
-             Vector<double>                &indicators,
-             const MPI_Comm                 mpi_communicator) const;
+    residual_estimate(const DoFHandler<dim>     &dof_handler,
+                      const VectorType          &ghosted_solution,
+                      const DiscreteAction<dim> &action,
+                      Vector<double>            &indicators,
+                      const MPI_Comm             mpi_communicator) const;
 
-  private:
-    /** The flux estimator: η_K² per cell, and η. */
-    double
+    /**
+     * The flux estimator: the same with the equilibrated fluxes of
+     * @p flux_reconstruction and the nodal λ_a of @p action.
+     */
+    FluxEstimate
     flux_estimate(const DoFHandler<dim>         &dof_handler,
                   const VectorType              &ghosted_solution,
+                  const DiscreteAction<dim>     &action,
                   const FluxReconstruction<dim> &flux_reconstruction,
                   Vector<double>                &indicators,
                   const MPI_Comm                 mpi_communicator) const;
 
+  private:
     /** Element residuals, oscillation and the contact term. */
     void
-    add_cell_terms(const DoFHandler<dim>         &dof_handler,
-                   const VectorType              &ghosted_solution,
-                   const FluxReconstruction<dim> &flux_reconstruction,
-                   Vector<double>                &indicators) const;
+    add_cell_terms(const DoFHandler<dim>     &dof_handler,
+                   const VectorType          &ghosted_solution,
+                   const DiscreteAction<dim> &action,
+                   Vector<double>            &indicators) const;
+
+    /** The boundary data part of FluxEstimate. */
+    double
+    boundary_data_part(const DoFHandler<dim> &dof_handler,
+                       const VectorType      &ghosted_solution,
+                       const MPI_Comm         mpi_communicator) const;
 
     /** ½ h_e μ_i⁻¹ ‖[μ_i ∂_n u_ih]‖²_e on both cells of every interior edge. */
     void
@@ -157,7 +182,6 @@ namespace membranes
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
-    const DiscreteAction<dim> &action;
   };
 } // namespace membranes
 

@@ -5,8 +5,8 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
-#include <membranes/flux_reconstruction.h>
 #include <membranes/problem_data.h>
 
 namespace membranes
@@ -19,7 +19,7 @@ namespace membranes
    * ‖λ − λ_h‖_{L2(ω_h)}, where λ_h is piecewise constant on the dual cells
    * D_a and ω_h is their union (ω minus a strip along ∂ω).
    *
-   * All integrals use the DualCellQuadrature of the FluxReconstruction, so
+   * All integrals use the DualCellQuadrature of DiscreteAction, so
    * that each quadrature point knows the dual cell D_a it lies in and λ_h
    * is evaluated exactly; the same rule integrates the displacement errors
    * over the whole cell.
@@ -40,12 +40,12 @@ namespace membranes
     ErrorNorms(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /** λ_h is the one of @p flux_reconstruction. */
+    /** λ_h is the one of @p action. */
     Errors
-    compute(const DoFHandler<dim>         &dof_handler,
-            const VectorType              &ghosted_solution,
-            const FluxReconstruction<dim> &flux_reconstruction,
-            const MPI_Comm                 mpi_communicator) const;
+    compute(const DoFHandler<dim>     &dof_handler,
+            const VectorType          &ghosted_solution,
+            const DiscreteAction<dim> &action,
+            const MPI_Comm             mpi_communicator) const;
 
   private:
     const Discretization<dim> &discretization;

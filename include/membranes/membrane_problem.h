@@ -75,6 +75,8 @@ namespace membranes
     compute_lambda_h();
     void
     postprocess();
+    bool
+    computes_fluxes() const;
     void
     reconstruct_fluxes();
     void

@@ -45,6 +45,18 @@ namespace membranes
     /** The flux estimator and its effectivity, with the flux reconstruction. */
     std::optional<double> flux_estimator, flux_effectivity;
     /**
+     * The parts of the flux estimator (ErrorEstimator::FluxEstimate): the
+     * flux part (Σ_i η_F,i²)^{1/2}, the oscillation part (Σ_i η_R,i²)^{1/2}
+     * and the contact part (2 B)^{1/2}; with the flux estimator.
+     */
+    std::optional<double> flux_estimator_flux, flux_estimator_oscillation,
+      flux_estimator_contact;
+    /**
+     * The boundary data part (ErrorEstimator::FluxEstimate::boundary), not
+     * part of the flux estimator; with it.
+     */
+    std::optional<double> flux_estimator_boundary;
+    /**
      * Defects of (4.17), (4.18) and of the balance of Lemma 17 (see
      * FluxReconstruction::Identities), with the flux reconstruction.
      */
