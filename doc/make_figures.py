@@ -16,7 +16,7 @@ VTK):
 * ``case-m-fields.png``: case M on Q1, 5 cycles: u1 − u2, λ_h (the nodal
   λ_a) and the active set, with the exact contact circle r = 1/2;
 * ``slit-adaptive-mesh.png``: the slit scene, 12 adaptive cycles: the mesh
-  refined towards the crack tip and the free boundary of the contact disk.
+  refined towards the crack tip, with the slit and the contact disk.
 
 The commands behind each figure are printed. Requires matplotlib.
 """
@@ -176,7 +176,7 @@ def adaptive_mesh_figure(membranes, out):
     axes.set_aspect("equal")
     axes.autoscale_view()
     axes.set_title("slit.prm after 11 adaptive refinements: the slit (red)\n"
-                   "and the free boundary of the contact disk (dashed)")
+                   "and the contact disk (dashed)")
     save(figure, os.path.join(out, "slit-adaptive-mesh.png"))
 
 
