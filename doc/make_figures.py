@@ -95,6 +95,16 @@ def triangles(vtu):
     return result
 
 
+def draw_cells(axes, vtu, linewidth, title):
+    """The cell edges of @p vtu in black, on equal axes fitted to them."""
+    axes.add_collection(PolyCollection(polygons(vtu), facecolors="none",
+                                       edgecolors="black",
+                                       linewidths=linewidth))
+    axes.set_aspect("equal")
+    axes.autoscale_view()
+    axes.set_title(title)
+
+
 def run(membranes, scene, directory, settings):
     command = [membranes] + sum((["--set", s] for s in settings), []) + [
         "--set", "Output/Directory=" + directory,
@@ -124,12 +134,9 @@ def dual_mesh_figure(membranes, out):
         cmap="tab20",
         edgecolors="white", linewidths=0.3)
     axes.add_collection(colours)
-    axes.add_collection(PolyCollection(polygons(primal), facecolors="none",
-                                       edgecolors="black", linewidths=1.2))
-    axes.set_aspect("equal")
-    axes.autoscale_view()
-    axes.set_title("Primal mesh (black) and the sub-triangles (a, m_e, b_K)\n"
-                   "of the dual cells D_a, one colour per vertex a")
+    draw_cells(axes, primal, 1.2,
+               "Primal mesh (black) and the sub-triangles (a, m_e, b_K)\n"
+               "of the dual cells D_a, one colour per vertex a")
     save(figure, os.path.join(out, "dual-mesh.png"))
 
 
@@ -168,15 +175,12 @@ def adaptive_mesh_figure(membranes, out):
     run(membranes, "slit.prm", directory, ["Refinement/Cycles=12"])
     vtu = read_vtu(os.path.join(directory, "solution-11.vtu"))
     figure, axes = plt.subplots(figsize=(6.5, 6.5))
-    axes.add_collection(PolyCollection(polygons(vtu), facecolors="none",
-                                       edgecolors="black", linewidths=0.2))
+    draw_cells(axes, vtu, 0.2,
+               "slit.prm after 11 adaptive refinements: the slit (red)\n"
+               "and the contact disk (dashed)")
     axes.plot([0, 1], [0, 0], color="red", linewidth=1.5)
     axes.add_patch(plt.Circle((-0.5, -0.5), 0.25, fill=False, color="blue",
                               linestyle="--", linewidth=1))
-    axes.set_aspect("equal")
-    axes.autoscale_view()
-    axes.set_title("slit.prm after 11 adaptive refinements: the slit (red)\n"
-                   "and the contact disk (dashed)")
     save(figure, os.path.join(out, "slit-adaptive-mesh.png"))
 
 
