@@ -1,0 +1,260 @@
+#!/usr/bin/env bash
+# Every table and figure of README.md, doc/tutorial.md and
+# benchmarks/README.md, made anew from the built program.
+#
+#   doc/make_results.sh [path/to/membranes] [work-dir]
+#
+# Defaults: build/membranes of this repository and /tmp/membranes-results.
+# Runs from the top of the source tree. It prints each command it runs
+# (lines starting with "+"), keeps every run's output under <work-dir>, and
+# writes each table, with the commands that made it, between the markers
+#
+#   <!-- results: NAME -->  ...  <!-- end of results: NAME -->
+#
+# of the documents (doc/results.py splice), and the figures to doc/images/.
+# SECTIONS in the environment chooses what to make (default: all of
+# "readme tutorial benchmarks"); "benchmarks" runs every script of
+# benchmarks/ (about an hour on two cores, up to 12 GB of memory for
+# mpi_scaling.sh) and the tutorial quotes some of their tables, so it comes
+# first. The peer benchmark needs python3-dolfinx; without it its table is
+# left as it is and the script says so. The figures need python3-matplotlib.
+#
+# A benchmark that misses one of its targets exits with status 1; its table
+# (with the FAIL line) is written all the same. The script stops at the first
+# run that fails in any other way, leaving the documents as they were for
+# the tables not yet made.
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+membranes=${1:-build/membranes}
+work=${2:-/tmp/membranes-results}
+sections=${SECTIONS:-benchmarks readme tutorial}
+python=/usr/bin/python3
+
+if [[ ! -x $membranes ]]; then
+  echo "make_results.sh: error: no program at '$membranes' (build it first)" >&2
+  exit 1
+fi
+mkdir -p "$work/blocks"
+
+# The command line as one would type it: arguments with spaces in quotes.
+quoted() {
+  local argument text=""
+  for argument in "$@"; do
+    [[ $argument == *" "* ]] && argument="\"$argument\""
+    text+="${text:+ }$argument"
+  done
+  printf '%s' "$text"
+}
+
+# run COMMAND...: print it, run it, and remember it for the next block.
+commands=()
+run() {
+  local line
+  line=$(quoted "$@")
+  echo "+ $line" >&2
+  commands+=("$line")
+  "$@"
+}
+
+# benchmark SCRIPT OUTPUT-DIR [ENV=VALUE...]: one script of benchmarks/, whose
+# missed targets (exit status 1) do not stop this script.
+benchmark() {
+  local script=$1 out=$2 status=0
+  shift 2
+  run env "$@" "benchmarks/$script" "$membranes" "$out" >"$out.log" 2>&1 ||
+    status=$?
+  if ((status > 1)) || [[ ! -s $out/table.md ]]; then
+    echo "make_results.sh: error: $script failed (status $status), see $out.log" >&2
+    exit 1
+  fi
+}
+
+# membranes_run NAME SCENE [--set ...]: the program on a scene, without field
+# output, into <work-dir>/NAME (progress in <work-dir>/NAME.log).
+membranes_run() {
+  local name=$1 scene=$2
+  shift 2
+  run "$membranes" --set "Output/Directory=$work/$name" \
+    --set "Output/Write vtu=false" "$@" "$scene" >"$work/$name.log"
+}
+
+# block DOCUMENT NAME < TABLE: the table, below the list of commands run since
+# the last block, between the markers NAME of DOCUMENT.
+block() {
+  local document=$1 name=$2 file="$work/blocks/$2.md" line
+  {
+    echo "Made by"
+    echo
+    echo '```sh'
+    for line in "${commands[@]}"; do echo "$line"; done
+    echo '```'
+    echo
+    cat
+  } >"$file"
+  $python doc/results.py splice "$document" "$name" "$file"
+  echo "  -> $document: $name"
+}
+
+# figure SOURCE IMAGE: copy a figure into doc/images/.
+figure() {
+  cp "$1" "doc/images/$2"
+  echo "  -> doc/images/$2"
+}
+
+machine() {
+  echo "On $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start, program built from commit $(git rev-parse --short HEAD)."
+}
+
+for section in $sections; do
+  case $section in
+  benchmarks)
+    commands=()
+    conditions=$(machine)
+    benchmark solver_cost.sh "$work/solver-cost"
+    { echo "$conditions"; echo; cat "$work/solver-cost/table.md"; } |
+      block benchmarks/README.md solver-cost
+
+    commands=()
+    conditions=$(machine)
+    benchmark solver_cost.sh "$work/solver-cost-balanced" STOPPING=balanced
+    { echo "$conditions"; echo; cat "$work/solver-cost-balanced/table.md"; } |
+      block benchmarks/README.md solver-cost-balanced
+
+    commands=()
+    conditions=$(machine)
+    benchmark adaptivity.sh "$work/adaptivity"
+    { echo "$conditions"; echo
+      $python doc/results.py comparisons "$work/adaptivity/table.md"; } |
+      block benchmarks/README.md adaptivity
+    figure "$work/adaptivity/lshape-convergence.png" lshape-convergence.png
+    figure "$work/adaptivity/slit-convergence.png" slit-convergence.png
+
+    for script in flux_estimator flux_effectivity stability mpi_scaling; do
+      commands=()
+      conditions=$(machine)
+      benchmark "$script.sh" "$work/$script"
+      { echo "$conditions"; echo; cat "$work/$script/table.md"; } |
+        block benchmarks/README.md "${script//_/-}"
+    done
+
+    commands=()
+    if $python -c "import dolfinx" 2>/dev/null; then
+      conditions=$(machine)
+      benchmark peer_snesvi.sh "$work/peer_snesvi"
+      { echo "$conditions"; echo; cat "$work/peer_snesvi/table.md"; } |
+        block benchmarks/README.md peer-snesvi
+    else
+      echo "make_results.sh: python3-dolfinx is missing: the table of peer_snesvi.sh is left as it is" >&2
+    fi
+    ;;
+
+  readme)
+    commands=()
+    run "$membranes" --set "Output/Directory=$work/default" \
+      parameters/default.prm >"$work/default.log"
+    run $python source/plot_report.py "$work/default/report.csv" \
+      --output "$work/default/convergence"
+    figure "$work/default/convergence.png" default-convergence.png
+    $python doc/results.py summary "$work/default/report.csv" |
+      block README.md default
+
+    # The table and the figures of the adaptive section come from
+    # benchmarks/adaptivity.sh (section benchmarks).
+    commands=("benchmarks/adaptivity.sh $membranes $work/adaptivity")
+    run $python doc/results.py adaptivity "$work/adaptivity" \
+      >"$work/blocks/adaptivity.table"
+    block README.md adaptivity <"$work/blocks/adaptivity.table"
+    ;;
+
+  tutorial)
+    commands=()
+    membranes_run case-m-q1 parameters/case-m-quadrilateral.prm
+    membranes_run case-m-p1 parameters/case-m-triangle.prm
+    membranes_run full-contact parameters/full-contact.prm
+    for name in case-m-q1 case-m-p1 full-contact; do
+      run $python doc/results.py errors "$work/$name/report.csv" \
+        >"$work/blocks/$name.table"
+    done
+    block doc/tutorial.md case-m-q1 <"$work/blocks/case-m-q1.table"
+    commands=("(the runs above)")
+    block doc/tutorial.md case-m-p1 <"$work/blocks/case-m-p1.table"
+    block doc/tutorial.md full-contact <"$work/blocks/full-contact.table"
+
+    commands=()
+    run $python source/plot_report.py --output "$work/case-m-convergence" \
+      --title "Case M" "$work/case-m-q1/report.csv=Q1" \
+      "$work/case-m-p1/report.csv=P1"
+    figure "$work/case-m-convergence.png" case-m-convergence.png
+    echo "(the runs of case M above)" | block doc/tutorial.md case-m-figure
+
+    reports=("$work/case-m-q1/report.csv=case M, Q1"
+      "$work/case-m-p1/report.csv=case M, P1"
+      "$work/full-contact/report.csv=full contact")
+    commands=()
+    run $python doc/results.py solver "${reports[@]}" >"$work/blocks/solver.table"
+    block doc/tutorial.md solver <"$work/blocks/solver.table"
+    commands=("(the run of case-m-quadrilateral.prm above; its progress output $work/case-m-q1.log)")
+    $python doc/results.py terminal "$work/case-m-q1.log" 4 |
+      block doc/tutorial.md terminal
+    commands=()
+    run $python doc/results.py identities "${reports[@]}" \
+      >"$work/blocks/identities.table"
+    block doc/tutorial.md identities <"$work/blocks/identities.table"
+
+    # Exact against balanced stopping on three scenes.
+    commands=()
+    arguments=()
+    for scene in "degenerate parameters/degenerate-free-boundary.prm" \
+      "case-m parameters/case-m-quadrilateral.prm --set Refinement/Cycles=8" \
+      "lshape parameters/lshape.prm"; do
+      read -r name file settings <<<"$scene"
+      for stopping in exact balanced; do
+        # shellcheck disable=SC2086
+        membranes_run "$name-$stopping" "$file" \
+          --set "Solver/Stopping=$stopping" $settings
+      done
+      arguments+=("$name" "$work/$name-exact/report.csv"
+        "$work/$name-balanced/report.csv")
+    done
+    run $python doc/results.py balanced "${arguments[@]}" \
+      >"$work/blocks/balanced.table"
+    { machine; echo; cat "$work/blocks/balanced.table"; } |
+      block doc/tutorial.md balanced
+
+    # Tables quoted from the benchmarks (section benchmarks).
+    commands=()
+    run $python doc/results.py flux-identities \
+      "$work/flux_estimator/case-m-q1/report.csv=case M, Q1" \
+      "$work/flux_estimator/case-m-p1/report.csv=case M, P1" \
+      >"$work/blocks/flux-identities.table"
+    block doc/tutorial.md flux-identities <"$work/blocks/flux-identities.table"
+    for script in flux_estimator flux_effectivity; do
+      commands=("benchmarks/$script.sh $membranes $work/$script")
+      block doc/tutorial.md "${script//_/-}" <"$work/$script/table.md"
+    done
+    commands=("benchmarks/adaptivity.sh $membranes $work/adaptivity")
+    run $python doc/results.py adaptivity "$work/adaptivity" \
+      >"$work/blocks/adaptivity.table"
+    block doc/tutorial.md adaptivity <"$work/blocks/adaptivity.table"
+
+    commands=()
+    run $python doc/make_figures.py "$membranes" "$work/figures" \
+      >"$work/figures.log"
+    mapfile -t drawn < <(sed -n 's/^\$ //p' "$work/figures.log")
+    commands+=("${drawn[@]}")
+    for image in dual-mesh case-m-fields slit-adaptive-mesh; do
+      figure "$work/figures/$image.png" "$image.png"
+    done
+    echo "The three figures of meshes and fields: dual-mesh.png, case-m-fields.png, slit-adaptive-mesh.png." |
+      block doc/tutorial.md figures
+    ;;
+
+  *)
+    echo "make_results.sh: error: unknown section '$section' in SECTIONS (allowed: benchmarks readme tutorial)" >&2
+    exit 1
+    ;;
+  esac
+done
+echo "make_results.sh: done; the documents and doc/images/ now hold the results of this run"
