@@ -4,6 +4,7 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/lapack_full_matrix.h>
+#include <deal.II/lac/vector.h>
 #include <map>
 #include <membranes/flux_reconstruction.h>
 #include <tuple>
@@ -397,6 +398,7 @@ namespace membranes
       for (unsigned int r = 0; r < sent[process].size(); ++r)
         add_patch_result(sent[process][r], buffer.data() + r * result_size);
     relax_rotations();
+    relax_cell_rotations();
   }
 
 
@@ -595,6 +597,80 @@ namespace membranes
                     sub_triangle_data[sorted[t].kappa].equilibrated[i][k] +=
                       c * sorted[t].u[k];
               }
+        }
+  }
+
+
+
+  /**
+   * The rotations of relax_rotations() are the curls of the piecewise
+   * linear stream functions on S_h: constant fields on each sub-triangle.
+   * On a quadrilateral −μ_i ∇u_ih also has the bilinear part
+   * μ_i ∂_xy u_ih (y, x) (on a parallelogram, in its axes), which is the
+   * curl of the quadratic μ_i ∂_xy u_ih (y² − x²)/2 and which no RT0 field
+   * of the sub-triangles follows. The quadratic edge bubbles 4 λ_p λ_q of
+   * the edges of S_h through b_K (from b_K to the vertices a and to the
+   * midpoints m_e) vanish on the boundary of the cell, so their curls β
+   * are fields without divergence and without normal flux through the
+   * cell's boundary: adding them keeps σ_ih in H(div) with the same
+   * divergence and the same fluxes through every edge of S_h, and the
+   * flux estimator remains a bound. On each cell the coefficients b
+   * minimize ‖μ_i^{-1/2} (σ_ih + Σ_l b_l β_l) + μ_i^{1/2} ∇u_ih‖_K: with
+   * the Gram matrices of the sub-triangles, a system B b = −(Mᵀ F + g) of
+   * 8 (Q1) or 6 (P1) unknowns per cell and membrane. The cells are
+   * independent, so no data of other processes is needed.
+   */
+  template <int dim>
+  void
+  FluxReconstruction<dim>::relax_cell_rotations()
+  {
+    const auto        &triangles   = dual_cell_quadrature.sub_triangles();
+    const unsigned int n_triangles = triangles.size();
+    const unsigned int n_vertices =
+      dof_handler->get_fe().reference_cell().n_vertices();
+    // The bubble of edge 0 of κ (from m_e to b_K) is unknown n_vertices + e,
+    // that of edge 1 (from a to b_K) unknown a.
+    const auto unknown = [&](const unsigned int s, const unsigned int l) {
+      return l == 0 ? n_vertices + triangles[s].face : triangles[s].vertex;
+    };
+    FullMatrix<double>            matrix(2 * n_vertices);
+    std::array<Vector<double>, 2> right_hand_side, coefficients;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        right_hand_side[i].reinit(2 * n_vertices);
+        coefficients[i].reinit(2 * n_vertices);
+      }
+    for (const auto &cell : dof_handler->active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          SubTriangleData *kappa =
+            sub_triangle_data.data() + cell->active_cell_index() * n_triangles;
+          matrix = 0;
+          for (unsigned int i = 0; i < 2; ++i)
+            right_hand_side[i] = 0;
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            for (unsigned int l = 0; l < 2; ++l)
+              {
+                for (unsigned int m = 0; m < 2; ++m)
+                  matrix(unknown(s, l), unknown(s, m)) +=
+                    kappa[s].rotation_gram[l][m];
+                for (unsigned int i = 0; i < 2; ++i)
+                  {
+                    double residual = kappa[s].discrete_rotation[i][l];
+                    for (unsigned int k = 0; k < 3; ++k)
+                      residual +=
+                        kappa[s].mixed_gram[k][l] * kappa[s].equilibrated[i][k];
+                    right_hand_side[i](unknown(s, l)) -= residual;
+                  }
+              }
+          matrix.gauss_jordan();
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              matrix.vmult(coefficients[i], right_hand_side[i]);
+              for (unsigned int s = 0; s < n_triangles; ++s)
+                for (unsigned int l = 0; l < 2; ++l)
+                  kappa[s].rotations[i][l] = coefficients[i](unknown(s, l));
+            }
         }
   }
 

@@ -195,6 +195,36 @@ namespace membranes
 
 
   template <int dim>
+  Tensor<1, dim>
+  FluxReconstruction<dim>::reference_rotation(const unsigned int s,
+                                              const unsigned int l,
+                                              const Point<dim>  &x) const
+  {
+    // λ_j is the linear function that is 1 at the corner c_j and 0 on the
+    // line through the other two, r·(x − c_{j+1}) / r·(c_j − c_{j+1}) with
+    // r normal to c_{j+2} − c_{j+1}; 4 λ_p λ_q has the gradient
+    // 4 (λ_p ∇λ_q + λ_q ∇λ_p), and the curl is (∂_y, −∂_x).
+    const auto &corners     = dual_cell_quadrature.sub_triangles()[s].corners;
+    const auto  barycentric = [&](const unsigned int j) {
+      const Tensor<1, dim> d = corners[(j + 2) % 3] - corners[(j + 1) % 3];
+      const double         scale =
+        cross_product_2d(d) * (corners[j] - corners[(j + 1) % 3]);
+      return std::make_pair(cross_product_2d(d) * (x - corners[(j + 1) % 3]) /
+                              scale,
+                            Tensor<1, dim>(cross_product_2d(d) / scale));
+    };
+    const auto [lambda_p, grad_p] = barycentric((l + 1) % 3);
+    const auto [lambda_q, grad_q] = barycentric((l + 2) % 3);
+    const Tensor<1, dim> gradient = 4 * (lambda_p * grad_q + lambda_q * grad_p);
+    Tensor<1, dim>       curl;
+    curl[0] = gradient[1];
+    curl[1] = -gradient[0];
+    return curl;
+  }
+
+
+
+  template <int dim>
   void
   FluxReconstruction<dim>::reconstruct(
     const DoFHandler<dim>           &dof_handler,
@@ -230,6 +260,15 @@ namespace membranes
                            unit,
                            points.quadrature.point(q));
         }
+    // The curls of the bubbles of edges 0 and 1 likewise.
+    std::vector<std::array<Tensor<1, dim>, 2>> reference_rotations(
+      points.n_volume);
+    for (unsigned int q = 0; q < points.n_volume; ++q)
+      for (unsigned int l = 0; l < 2; ++l)
+        reference_rotations[q][l] =
+          reference_rotation(dual_cell_quadrature.sub_triangle_of_point(q),
+                             l,
+                             points.quadrature.point(q));
     const unsigned int      n_vertices = fe.reference_cell().n_vertices();
     std::vector<Point<dim>> volume_points(points.n_volume);
     std::vector<double>     load(points.n_volume);
@@ -366,13 +405,26 @@ namespace membranes
                       psi[k] = DF * reference_basis[q][k] / det;
                     const double JxW = fe_values.JxW(q);
                     kappa.area += JxW;
+                    std::array<Tensor<1, dim>, 2> beta;
+                    for (unsigned int l = 0; l < 2; ++l)
+                      beta[l] = DF * reference_rotations[q][l] / det;
                     for (unsigned int k = 0; k < 3; ++k)
                       {
                         for (unsigned int l = 0; l < 3; ++l)
                           kappa.gram[k][l] += psi[k] * psi[l] * JxW;
+                        for (unsigned int l = 0; l < 2; ++l)
+                          kappa.mixed_gram[k][l] += psi[k] * beta[l] * JxW;
                         for (unsigned int i = 0; i < 2; ++i)
                           kappa.discrete_flux[i][k] +=
                             data.mu[i] * gradients[i][q] * psi[k] * JxW;
+                      }
+                    for (unsigned int l = 0; l < 2; ++l)
+                      {
+                        for (unsigned int m = 0; m < 2; ++m)
+                          kappa.rotation_gram[l][m] += beta[l] * beta[m] * JxW;
+                        for (unsigned int i = 0; i < 2; ++i)
+                          kappa.discrete_rotation[i][l] +=
+                            data.mu[i] * gradients[i][q] * beta[l] * JxW;
                       }
                     for (unsigned int i = 0; i < 2; ++i)
                       kappa.load[i] += loads[i][q] * JxW;
@@ -581,12 +633,16 @@ namespace membranes
     for (unsigned int q = 0; q < quadrature.size(); ++q)
       {
         const unsigned int s = dual_cell_quadrature.sub_triangle_of_point(q);
-        const auto        &f =
-          sub_triangle_data[cell->active_cell_index() * n_triangles + s]
-            .equilibrated[i];
+        const SubTriangleData &kappa =
+          sub_triangle_data[cell->active_cell_index() * n_triangles + s];
+        const auto          &f   = kappa.equilibrated[i];
         const Tensor<2, dim> DF  = to_tensor(fe_values.jacobian(q));
         const double         det = std::abs(determinant(DF));
-        flux[q]       = DF * reference_flux(s, f, quadrature.point(q)) / det;
+        Tensor<1, dim> reference = reference_flux(s, f, quadrature.point(q));
+        for (unsigned int l = 0; l < 2; ++l)
+          reference += kappa.rotations[i][l] *
+                       reference_rotation(s, l, quadrature.point(q));
+        flux[q]       = DF * reference / det;
         divergence[q] = (f[0] + f[1] + f[2]) / (triangles[s].area * det);
       }
   }

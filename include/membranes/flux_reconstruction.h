@@ -132,7 +132,10 @@ namespace membranes
    * take half of the hat functions of their ends, which carries the
    * corrections across (P1 adaptive: the straight free boundary
    * 1.389 → 1.044, the disk 1.378 → 1.085). Vertices on ∂ω are left out:
-   * the normal flux there stays that of the patch problems.
+   * the normal flux there stays that of the patch problems. Last, inside
+   * each cell, the curls of the quadratic edge bubbles of the edges of S_h
+   * through b_K (relax_cell_rotations()) follow the bilinear part of a Q1
+   * gradient, which no RT0 field of the sub-triangles does.
    *
    * On each cell the sub-triangles form a ring around b_K; with the
    * fluxes through their half-edges and one circulation per cell, the
@@ -251,6 +254,18 @@ namespace membranes
       std::array<std::array<double, 3>, 3> gram{};
       /** (μ_i ∇u_ih, ψ_k)_κ. */
       std::array<std::array<double, 3>, 2> discrete_flux{};
+      /**
+       * Coefficients of the rotations inside the cell: the curls β_l of
+       * the edge bubbles 4 λ_p λ_q of the edges l = 0, 1 of κ, those
+       * through b_K (see relax_cell_rotations()), per i.
+       */
+      std::array<std::array<double, 2>, 2> rotations{};
+      /** (β_l, β_m)_κ. */
+      std::array<std::array<double, 2>, 2> rotation_gram{};
+      /** (ψ_k, β_l)_κ. */
+      std::array<std::array<double, 2>, 3> mixed_gram{};
+      /** (μ_i ∇u_ih, β_l)_κ. */
+      std::array<std::array<double, 2>, 2> discrete_rotation{};
       /** ∫_κ f_i. */
       std::array<double, 2> load{};
       double                area = 0;
@@ -285,6 +300,16 @@ namespace membranes
     reference_flux(const unsigned int           s,
                    const std::array<double, 3> &fluxes,
                    const Point<dim>            &x) const;
+
+    /**
+     * The curl of the edge bubble 4 λ_p λ_q of edge @p l of sub-triangle
+     * @p s (p, q its ends, λ the barycentric coordinates of the reference
+     * sub-triangle) at the reference point @p x.
+     */
+    Tensor<1, dim>
+    reference_rotation(const unsigned int s,
+                       const unsigned int l,
+                       const Point<dim>  &x) const;
 
     /**
      * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch
@@ -334,6 +359,15 @@ namespace membranes
 
     /** Sweeps of relax_rotations(). */
     static constexpr unsigned int rotation_sweeps = 3;
+
+    /**
+     * Rotations inside each locally owned cell: the curls of the edge
+     * bubbles of the edges of S_h through b_K, with the coefficients that
+     * minimize the distance of σ_ih from −μ_i ∇u_ih on the cell (see the
+     * .cc file).
+     */
+    void
+    relax_cell_rotations();
 
     /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
     void
