@@ -160,6 +160,19 @@ for section in $sections; do
     $python doc/results.py summary "$work/default/report.csv" |
       block README.md default
 
+    commands=()
+    run "$membranes" --set "Output/Directory=$work/own-scene" \
+      --set "Output/Write vtu=false" parameters/own-scene.prm \
+      >"$work/own-scene.log"
+    run "$membranes" --set Refinement/Strategy=global \
+      --set Refinement/Cycles=5 --set "Output/Directory=$work/own-scene-uniform" \
+      --set "Output/Write vtu=false" parameters/own-scene.prm \
+      >"$work/own-scene-uniform.log"
+    run $python doc/results.py estimators \
+      "$work/own-scene/report.csv=adaptive" \
+      "$work/own-scene-uniform/report.csv=uniform" >"$work/blocks/own-scene.table"
+    block README.md own-scene <"$work/blocks/own-scene.table"
+
     # The table and the figures of the adaptive section come from
     # benchmarks/adaptivity.sh (section benchmarks).
     commands=("benchmarks/adaptivity.sh $membranes $work/adaptivity")

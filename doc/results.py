@@ -12,12 +12,13 @@ Usage::
     results.py terminal run.log CYCLE
     results.py balanced LABEL exact/report.csv balanced/report.csv [...]
     results.py summary report.csv
+    results.py estimators report.csv=LABEL ...
     results.py adaptivity OUTPUT-DIR
     results.py comparisons table.md
     results.py splice DOCUMENT NAME BLOCK-FILE
     results.py check DOCUMENT NAME report.csv
 
-The first nine print Markdown to standard output:
+The first ten print Markdown to standard output:
 
 * ``errors``: per cycle the cells, DoFs and the error columns with their
   rates in h (h ~ N^(-1/2), uniform refinement), as the program's terminal
@@ -32,6 +33,9 @@ The first nine print Markdown to standard output:
   sums over the cycles and the finest cycle;
 * ``summary``: one sentence on a run: its last cycle, the rate of the energy
   error in N and the effectivity range of the estimator;
+* ``estimators``: per run its last cycle, DoFs and estimator, and the rate r
+  of estimator ~ N^(-r) (least squares over the last half of the cycles),
+  for scenes without an exact solution;
 * ``adaptivity``: one row per scene and cell type of the output directory of
   benchmarks/adaptivity.sh: rates, N/N_u and T/T_u at equal error, the
   effectivity band and the most active set iterations after the first cycle;
@@ -193,6 +197,22 @@ def summary(path):
             f"all cycles.")
 
 
+def estimators(arguments):
+    table = []
+    for path, label in labelled(arguments):
+        rows = read_report(path)
+        half = rows[len(rows) // 2:]
+        x = [math.log(value(r, "dofs")) for r in half]
+        y = [math.log(value(r, "estimator")) for r in half]
+        mx, my = sum(x) / len(x), sum(y) / len(y)
+        slope = sum((a - mx) * (b - my) for a, b in zip(x, y)) / \
+            sum((a - mx) ** 2 for a in x)
+        table.append([label, rows[-1]["cycle"], rows[-1]["dofs"],
+                      f"{value(rows[-1], 'estimator'):.3f}", f"{-slope:.2f}"])
+    return markdown(["run", "last cycle", "dofs", "estimator", "rate in N"],
+                    table, "lrrrr")
+
+
 def adaptivity(directory):
     header = ["scene", "uniform rate", "adaptive rate", "$N/N_u$",
               "$T/T_u$", "effectivity band (adaptive)",
@@ -316,6 +336,7 @@ def main(argv):
         "terminal": lambda a: terminal(a[0], int(a[1])),
         "balanced": balanced,
         "summary": lambda a: summary(*a),
+        "estimators": estimators,
         "adaptivity": lambda a: adaptivity(*a),
         "comparisons": lambda a: comparisons(*a),
         "splice": lambda a: splice(*a),
