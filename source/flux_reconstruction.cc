@@ -155,6 +155,15 @@ namespace membranes
                                  points.edge_point(s, e, k))) :
                 0.);
 
+    for (unsigned int q = 0; q < points.n_volume; ++q)
+      rotation_basis.push_back(
+        {{reference_rotation(dual_cell_quadrature.sub_triangle_of_point(q),
+                             0,
+                             points.quadrature.point(q)),
+          reference_rotation(dual_cell_quadrature.sub_triangle_of_point(q),
+                             1,
+                             points.quadrature.point(q))}});
+
     // Around b_K, sub-triangle (a, m_e, b_K) meets (a', m_e, b_K), a' the
     // other end of e, across edge 0, and (a, m_e', b_K), e' the other edge
     // through a, across edge 1.
@@ -260,15 +269,6 @@ namespace membranes
                            unit,
                            points.quadrature.point(q));
         }
-    // The curls of the bubbles of edges 0 and 1 likewise.
-    std::vector<std::array<Tensor<1, dim>, 2>> reference_rotations(
-      points.n_volume);
-    for (unsigned int q = 0; q < points.n_volume; ++q)
-      for (unsigned int l = 0; l < 2; ++l)
-        reference_rotations[q][l] =
-          reference_rotation(dual_cell_quadrature.sub_triangle_of_point(q),
-                             l,
-                             points.quadrature.point(q));
     const unsigned int      n_vertices = fe.reference_cell().n_vertices();
     std::vector<Point<dim>> volume_points(points.n_volume);
     std::vector<double>     load(points.n_volume);
@@ -407,7 +407,7 @@ namespace membranes
                     kappa.area += JxW;
                     std::array<Tensor<1, dim>, 2> beta;
                     for (unsigned int l = 0; l < 2; ++l)
-                      beta[l] = DF * reference_rotations[q][l] / det;
+                      beta[l] = DF * rotation_basis[q][l] / det;
                     for (unsigned int k = 0; k < 3; ++k)
                       {
                         for (unsigned int l = 0; l < 3; ++l)
@@ -640,8 +640,7 @@ namespace membranes
         const double         det = std::abs(determinant(DF));
         Tensor<1, dim> reference = reference_flux(s, f, quadrature.point(q));
         for (unsigned int l = 0; l < 2; ++l)
-          reference += kappa.rotations[i][l] *
-                       reference_rotation(s, l, quadrature.point(q));
+          reference += kappa.rotations[i][l] * rotation_basis[q][l];
         flux[q]       = DF * reference / det;
         divergence[q] = (f[0] + f[1] + f[2]) / (triangles[s].area * det);
       }

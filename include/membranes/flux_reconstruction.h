@@ -393,6 +393,12 @@ namespace membranes
      * sub-triangle s, at ((s · 3 + e) · 2 + k) · 4 + v.
      */
     std::vector<double> edge_shape_values;
+
+    /**
+     * reference_rotation() of the edges 0 and 1 of the sub-triangle of each
+     * point of the dual quadrature, at that point.
+     */
+    std::vector<std::array<Tensor<1, dim>, 2>> rotation_basis;
     /** f_1, f_2 at the points of the dual quadrature, cell by cell. */
     std::vector<double> load_at_points;
     Identities          defects;
