@@ -1,11 +1,16 @@
+// Boost's JSON reader includes boost/bind.hpp, which otherwise notes at every
+// build that its placeholders in the global namespace are deprecated.
+#define BOOST_BIND_GLOBAL_PLACEHOLDERS
+
 #include <algorithm>
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <deal.II/base/utilities.h>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <membranes/parameters.h>
 #include <optional>
 #include <sstream>
@@ -167,6 +172,8 @@ namespace membranes::Parameters
 
   namespace
   {
+    using boost::property_tree::ptree;
+
     /** A subsection path, and optionally an entry in it, as `A/B/entry`. */
     std::string
     joined(std::vector<std::string> path, const std::string &name = "")
@@ -179,282 +186,191 @@ namespace membranes::Parameters
       return text;
     }
 
-    /** `a, b, c` */
+    /**
+     * The declared parameters as ParameterHandler holds them: a tree whose
+     * nodes are the subsections and the entries, in declaration order; an
+     * entry has the children `value`, `pattern_description`, ... (deal.II's
+     * JSON description of the parameters).
+     */
+    ptree
+    declarations()
+    {
+      ParameterHandler prm;
+      All::declare_parameters(prm);
+      std::stringstream json;
+      prm.print_parameters(json,
+                           ParameterHandler::OutputStyle(
+                             ParameterHandler::JSON |
+                             ParameterHandler::KeepDeclarationOrder));
+      ptree tree;
+      boost::property_tree::read_json(json, tree);
+      return tree;
+    }
+
+    /** Whether @p node of declarations() is an entry, not a subsection. */
+    bool
+    is_entry(const ptree &node)
+    {
+      return node.count("pattern_description") > 0;
+    }
+
+    /** The entries (or the subsections) in @p node, as `a, b, c`. */
     std::string
-    listed(const std::vector<std::string> &names)
+    names_in(const ptree &node, const bool entries)
     {
       std::string text;
-      for (const std::string &name : names)
-        text += (text.empty() ? "" : ", ") + name;
+      for (const auto &[name, child] : node)
+        if (is_entry(child) == entries)
+          text += (text.empty() ? "" : ", ") + name;
       return text;
     }
 
-    /** One statement of a parameter file, as far as messages need it. */
-    struct Statement
-    {
-      unsigned int             line; ///< Where it starts (1-based).
-      std::vector<std::string> path; ///< The subsections it is in.
-      std::string keyword; ///< set, subsection, end, include, or empty.
-      std::string name;    ///< The entry or subsection it names.
-      std::string value;   ///< The value of a set statement.
-      bool        has_value = false; ///< Whether a set statement has '='.
-      std::string text;              ///< The statement, comment removed.
-    };
-
     /**
-     * The statements of a parameter file in deal.II's syntax (the way
-     * ParameterHandler::parse_input() reads it): lines ending in '\\' joined
-     * with the next, comments from '#' removed, blank lines skipped, and
-     * each statement with the subsections it is in.
-     */
-    std::vector<Statement>
-    statements_of(std::istream &in)
-    {
-      std::vector<Statement>   statements;
-      std::vector<std::string> path;
-      std::string              line, joined_lines;
-      unsigned int             number = 0, start = 0;
-      while (std::getline(in, line))
-        {
-          ++number;
-          if (joined_lines.empty())
-            start = number;
-          line = trim(line);
-          if (!line.empty() && line.back() == '\\')
-            {
-              joined_lines += line.substr(0, line.size() - 1);
-              continue;
-            }
-          std::string text = joined_lines + line;
-          joined_lines.clear();
-          text = text.substr(0, text.find('#'));
-          std::replace(text.begin(), text.end(), '\t', ' ');
-          text = trim(text);
-          if (text.empty())
-            continue;
-
-          Statement  statement{start, path, "", "", "", false, text};
-          const auto keyword = [&](const std::string &lower) {
-            std::string upper = lower;
-            for (char &c : upper)
-              c = static_cast<char>(std::toupper(c));
-            for (const std::string &word : {lower, upper})
-              if (text.rfind(word + " ", 0) == 0 ||
-                  (lower == "end" && text == word))
-                {
-                  statement.keyword = lower;
-                  return trim(text.substr(word.size()));
-                }
-            return std::string();
-          };
-          for (const std::string word : {"set", "subsection", "end", "include"})
-            {
-              statement.name = keyword(word);
-              if (!statement.keyword.empty())
-                break;
-            }
-          if (statement.keyword == "set")
-            {
-              const auto equal    = statement.name.find('=');
-              statement.has_value = (equal != std::string::npos);
-              if (statement.has_value)
-                {
-                  statement.value = trim(statement.name.substr(equal + 1));
-                  statement.name  = trim(statement.name.substr(0, equal));
-                }
-            }
-          else if (statement.keyword == "subsection")
-            path.push_back(statement.name);
-          else if (statement.keyword == "end" && !path.empty())
-            path.pop_back();
-          statements.push_back(statement);
-        }
-      return statements;
-    }
-
-
-
-    /**
-     * The declared parameters: the entries and the subsections of every
-     * subsection path (`""` for the top level), in declaration order, read
-     * back from what ParameterHandler prints.
-     */
-    struct Declarations
-    {
-      std::map<std::string, std::vector<std::string>> entries, subsections;
-
-      Declarations()
-      {
-        ParameterHandler prm;
-        All::declare_parameters(prm);
-        std::stringstream text;
-        prm.print_parameters(text,
-                             ParameterHandler::OutputStyle(
-                               ParameterHandler::ShortPRM |
-                               ParameterHandler::KeepDeclarationOrder));
-        for (const Statement &statement : statements_of(text))
-          if (statement.keyword == "set")
-            entries[joined(statement.path)].push_back(statement.name);
-          else if (statement.keyword == "subsection")
-            subsections[joined(statement.path)].push_back(statement.name);
-      }
-
-      /** The names in @p kind (entries or subsections) of @p path. */
-      static std::vector<std::string>
-      in(const std::map<std::string, std::vector<std::string>> &kind,
-         const std::vector<std::string>                        &path)
-      {
-        const auto found = kind.find(joined(path));
-        return found == kind.end() ? std::vector<std::string>() : found->second;
-      }
-
-      static bool
-      has(const std::map<std::string, std::vector<std::string>> &kind,
-          const std::vector<std::string>                        &path,
-          const std::string                                     &name)
-      {
-        const auto names = in(kind, path);
-        return std::find(names.begin(), names.end(), name) != names.end();
-      }
-    };
-
-
-
-    /**
-     * The InputError (at @p where) for the first subsection of @p path that
-     * is not declared, if there is one.
-     */
-    std::optional<InputError>
-    undeclared_subsection(const Declarations             &declared,
-                          const std::vector<std::string> &path,
-                          const std::string              &where)
-    {
-      std::vector<std::string> prefix;
-      for (const std::string &subsection : path)
-        {
-          if (!declared.has(declared.subsections, prefix, subsection))
-            {
-              const auto known = declared.in(declared.subsections, prefix);
-              return InputError(
-                where + joined(prefix, subsection) + " is not a subsection: " +
-                (known.empty() ? joined(prefix) + " has no subsections" :
-                                 "the subsections" +
-                                   (prefix.empty() ? std::string() :
-                                                     " of " + joined(prefix)) +
-                                   " are " + listed(known)));
-            }
-          prefix.push_back(subsection);
-        }
-      return std::nullopt;
-    }
-
-
-
-    /**
-     * Why `path/name = value` (at @p where) is not accepted: a subsection of
+     * Why `path/name = value` cannot be set in @p declared: a subsection of
      * @p path that is not declared, an entry that is not, or a value that
-     * does not match the entry's pattern (@p reason, deal.II's message, then
-     * says which).
+     * the entry's pattern does not match; an empty string if it can be.
+     * Without @p name, only @p path is checked.
      */
-    InputError
-    assignment_error(const std::vector<std::string> &path,
-                     const std::string              &name,
-                     const std::string              &value,
-                     const std::string              &where,
-                     const std::string              &reason)
+    std::string
+    wrong_assignment(const ptree                    &declared,
+                     const std::vector<std::string> &path,
+                     const std::string              &name  = "",
+                     const std::string              &value = "")
     {
-      const Declarations declared;
-      if (const auto error = undeclared_subsection(declared, path, where))
-        return *error;
-      if (!declared.has(declared.entries, path, name))
-        return InputError(where + joined(path, name) + " is not a parameter: " +
-                          (path.empty() ?
-                             "entries are set inside the subsections " +
-                               listed(declared.in(declared.subsections, {})) :
-                             "the entries of " + joined(path) + " are " +
-                               listed(declared.in(declared.entries, path))));
-      // The pattern is the end of deal.II's message, as in "... does not
-      // match the given pattern: [Integer range 0...20 (inclusive)]".
-      const auto        at = reason.rfind("pattern");
-      const std::string pattern =
-        at == std::string::npos ? reason : trim(reason.substr(at + 7));
-      const auto first = pattern.find_first_not_of(":< ");
-      const auto last  = pattern.find_last_not_of(">. ");
-      return InputError(
-        where +
-        invalid_entry(joined(path, name),
-                      value,
-                      "expected " + (first == std::string::npos ?
-                                       pattern :
-                                       pattern.substr(first, last - first + 1)))
-          .what());
+      const ptree *node = &declared;
+      for (std::size_t depth = 0; depth < path.size(); ++depth)
+        {
+          const auto subsection = node->find(path[depth]);
+          if (subsection == node->not_found() || is_entry(subsection->second))
+            {
+              const std::vector<std::string> parent(path.begin(),
+                                                    path.begin() + depth);
+              const std::string              known = names_in(*node, false);
+              return joined(parent, path[depth]) + " is not a subsection: " +
+                     (known.empty() ?
+                        joined(parent) + " has no subsections" :
+                        "the subsections" +
+                          (parent.empty() ? "" : " of " + joined(parent)) +
+                          " are " + known);
+            }
+          node = &subsection->second;
+        }
+      if (name.empty())
+        return "";
+      const auto entry = node->find(name);
+      if (entry == node->not_found() || !is_entry(entry->second))
+        return joined(path, name) + " is not a parameter: " +
+               (path.empty() ? "entries are set inside the subsections " +
+                                 names_in(declared, false) :
+                               "the entries of " + joined(path) + " are " +
+                                 names_in(*node, true));
+      const auto pattern =
+        entry->second.get<std::string>("pattern_description");
+      if (!dealii::Patterns::pattern_factory(pattern)->match(value))
+        return invalid_entry(joined(path, name), value, "expected " + pattern)
+          .what();
+      return "";
     }
 
+    /**
+     * Why deal.II's parser refuses the @p statement of a parameter file, in
+     * the subsections @p path, which a `subsection` or `end` statement
+     * changes; an empty string if it accepts it. The statement is read in
+     * deal.II's syntax: a comment from '#' on, the keywords `set`,
+     * `subsection`, `end` and `include`, also in capitals.
+     */
+    std::string
+    wrong_statement(const ptree              &declared,
+                    std::vector<std::string> &path,
+                    std::string               statement)
+    {
+      statement = statement.substr(0, statement.find('#'));
+      std::replace(statement.begin(), statement.end(), '\t', ' ');
+      statement = trim(statement);
+      // What follows the keyword at the start of the statement, if any.
+      const auto after =
+        [&statement](std::string keyword) -> std::optional<std::string> {
+        for (int capitals = 0; capitals < 2; ++capitals)
+          {
+            if (statement.rfind(keyword, 0) == 0)
+              return trim(statement.substr(keyword.size()));
+            for (char &c : keyword)
+              c = static_cast<char>(std::toupper(c));
+          }
+        return std::nullopt;
+      };
 
+      if (statement.empty())
+        return "";
+      if (const auto name = after("subsection "))
+        {
+          path.push_back(*name);
+          return wrong_assignment(declared, path);
+        }
+      if (const auto rest = after("end"); rest && rest->empty())
+        {
+          if (path.empty())
+            return "'end' without a subsection to end";
+          path.pop_back();
+          return "";
+        }
+      if (const auto file = after("include "))
+        return std::ifstream(*file) ?
+                 "" :
+                 "the file '" + *file + "' to include cannot be opened";
+      if (const auto assignment = after("set "))
+        if (const auto equal = assignment->find('=');
+            equal != std::string::npos)
+          return wrong_assignment(declared,
+                                  path,
+                                  trim(assignment->substr(0, equal)),
+                                  trim(assignment->substr(equal + 1)));
+      return (path.empty() ? "" : "in subsection " + joined(path) + ": ") +
+             "cannot parse '" + statement +
+             "': expected 'set Entry = value', 'subsection Name', 'end' or "
+             "'include file'";
+    }
 
     /**
-     * The InputError for the scene @p file_name, which deal.II rejected with
-     * @p reason: the statement at the line the reason names, read again
-     * here, says which entry or subsection is wrong.
+     * The first error in the scene @p file_name, as `file, line N: why`:
+     * a statement that deal.II's parser refuses (lines ending in '\\' are
+     * joined with the next into one statement, as it does), or a subsection
+     * without 'end'. An empty string if there is none.
      */
-    InputError
-    scene_error(const std::string &file_name, const std::string &reason)
+    std::string
+    first_error(const std::string &file_name)
     {
-      std::ifstream in(file_name);
-      const auto    statements = statements_of(in);
-      const auto    at         = reason.find("Line <");
-      if (at == std::string::npos)
+      const ptree               declared = declarations();
+      std::ifstream             in(file_name);
+      std::vector<std::string>  path;
+      std::vector<unsigned int> opened; // The line of each subsection of path.
+      std::string               line, statement;
+      unsigned int              start = 1;
+      const auto                at    = [&file_name](const unsigned int line) {
+        return file_name + ", line " + std::to_string(line) + ": ";
+      };
+      for (unsigned int number = 1; std::getline(in, line); ++number)
         {
-          // No line: the file ends inside a subsection.
-          std::vector<std::string> open;
-          unsigned int             line = 0;
-          for (const Statement &statement : statements)
-            if (statement.keyword == "subsection")
-              {
-                open = statement.path;
-                open.push_back(statement.name);
-                line = statement.line;
-              }
-            else if (statement.keyword == "end" && !open.empty())
-              open.pop_back();
-          if (open.empty())
-            return InputError(file_name + ": " + reason);
-          return InputError(file_name + ", line " + std::to_string(line) +
-                            ": subsection " + joined(open) +
-                            " has no 'end' before the end of the file");
+          line                 = trim(line);
+          const bool continued = !line.empty() && line.back() == '\\';
+          statement += continued ? line.substr(0, line.size() - 1) : line;
+          if (continued)
+            continue;
+          const std::size_t depth = path.size();
+          const std::string error = wrong_statement(declared, path, statement);
+          if (!error.empty())
+            return at(start) + error;
+          if (path.size() > depth)
+            opened.push_back(start);
+          else if (path.size() < depth)
+            opened.pop_back();
+          statement.clear();
+          start = number + 1;
         }
-
-      const unsigned int line = std::stoul(reason.substr(at + 6));
-      const std::string  where =
-        file_name + ", line " + std::to_string(line) + ": ";
-      const auto statement =
-        std::find_if(statements.rbegin(),
-                     statements.rend(),
-                     [&](const Statement &s) { return s.line <= line; });
-      if (statement == statements.rend())
-        return InputError(where + reason);
-      const Statement &s = *statement;
-      if (s.keyword == "set" && s.has_value)
-        return assignment_error(s.path, s.name, s.value, where, reason);
-      if (s.keyword == "subsection")
-        {
-          auto path = s.path;
-          path.push_back(s.name);
-          if (const auto error =
-                undeclared_subsection(Declarations(), path, where))
-            return *error;
-        }
-      const std::string context = s.path.empty() ?
-                                    std::string() :
-                                    "in subsection " + joined(s.path) + ": ";
-      if (s.keyword == "end")
-        return InputError(where + "'end' without a subsection to end");
-      if (s.keyword == "include")
-        return InputError(where + context +
-                          reason.substr(reason.find(": ") + 2));
-      return InputError(where + context + "cannot parse '" + s.text +
-                        "': expected 'set Entry = value', 'subsection Name', "
-                        "'end' or 'include file'");
+      if (path.empty())
+        return "";
+      return at(opened.back()) + "subsection " + joined(path) +
+             " has no 'end' before the end of the file";
     }
   } // namespace
 
@@ -473,7 +389,9 @@ namespace membranes::Parameters
       }
     catch (const dealii::ExceptionBase &e)
       {
-        throw scene_error(file_name, one_line_message(e));
+        const std::string error = first_error(file_name);
+        throw InputError(
+          error.empty() ? file_name + ": " + one_line_message(e) : error);
       }
   }
 
@@ -494,20 +412,13 @@ namespace membranes::Parameters
     const auto subsections =
       dealii::Utilities::split_string_list(assignment.substr(0, slash), '/');
     const std::string value = trim(assignment.substr(equal + 1));
-    const std::string where = "--set '" + assignment + "': ";
-    if (!prm.subsection_path_exists(subsections))
-      throw assignment_error(subsections, entry, value, where, "");
+    if (const std::string error =
+          wrong_assignment(declarations(), subsections, entry, value);
+        !error.empty())
+      throw InputError("--set '" + assignment + "': " + error);
     for (const auto &subsection : subsections)
       prm.enter_subsection(subsection);
-    try
-      {
-        prm.set(entry, value);
-      }
-    catch (const dealii::ExceptionBase &e)
-      {
-        throw assignment_error(
-          subsections, entry, value, where, one_line_message(e));
-      }
+    prm.set(entry, value);
     for (unsigned int i = 0; i < subsections.size(); ++i)
       prm.leave_subsection();
   }
@@ -666,10 +577,13 @@ namespace membranes::Parameters
     prm.enter_subsection("Problem");
     prm.declare_entry("mu1",
                       "1",
-                      Double(),
+                      Double(1 / max_magnitude, max_magnitude),
                       "Tension of membrane 1, in [1e-50, 1e50], with "
                       "mu1/mu2 in [1e-12, 1e12].");
-    prm.declare_entry("mu2", "1", Double(), "Tension of membrane 2, likewise.");
+    prm.declare_entry("mu2",
+                      "1",
+                      Double(1 / max_magnitude, max_magnitude),
+                      "Tension of membrane 2, likewise.");
     prm.declare_entry("Function constants",
                       "",
                       dealii::Patterns::Anything(),
@@ -702,16 +616,6 @@ namespace membranes::Parameters
     prm.enter_subsection("Problem");
     mu1 = get_double(prm, "Problem", "mu1");
     mu2 = get_double(prm, "Problem", "mu2");
-    for (const auto &[name, value] : {std::pair{"mu1", mu1}, {"mu2", mu2}})
-      if (!(value >= 1 / max_magnitude && value <= max_magnitude))
-        {
-          std::ostringstream allowed;
-          allowed << "a tension must be a number in [" << 1 / max_magnitude
-                  << ", " << max_magnitude << "]";
-          throw invalid_entry(std::string("Problem/") + name,
-                              prm.get(name),
-                              allowed.str());
-        }
     if (!(mu1 <= max_tension_ratio * mu2 && mu2 <= max_tension_ratio * mu1))
       {
         std::ostringstream message;

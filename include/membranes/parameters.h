@@ -9,8 +9,8 @@
  * The run-time parameters of a scene. Each struct mirrors one subsection of
  * the parameter file (SPEC §3.2); `declare_parameters()` documents every
  * entry, `parse_parameters()` reads it into typed fields and rejects values
- * that the pattern cannot catch (e.g. a tension that is not positive) with
- * a one-line message naming the entry.
+ * that the pattern cannot catch (e.g. a ratio of the tensions beyond
+ * max_tension_ratio) with a one-line message naming the entry.
  */
 namespace membranes::Parameters
 {
