@@ -272,6 +272,70 @@ namespace membranes::Parameters
       return "";
     }
 
+    /** @p statement without its comment (from '#' on), tabs and margins. */
+    std::string
+    without_comment(std::string statement)
+    {
+      statement = statement.substr(0, statement.find('#'));
+      std::replace(statement.begin(), statement.end(), '\t', ' ');
+      return trim(statement);
+    }
+
+    /**
+     * What follows @p keyword (in lower case or in capitals, as deal.II
+     * reads it) at the start of @p statement, if it starts with it.
+     */
+    std::optional<std::string>
+    after_keyword(const std::string &statement, std::string keyword)
+    {
+      for (int capitals = 0; capitals < 2; ++capitals)
+        {
+          if (statement.rfind(keyword, 0) == 0)
+            return trim(statement.substr(keyword.size()));
+          for (char &c : keyword)
+            c = static_cast<char>(std::toupper(c));
+        }
+      return std::nullopt;
+    }
+
+    /**
+     * `file, line N: why` if the scene @p file_name includes itself, directly
+     * or through other files (deal.II's parser would recurse until the
+     * stack overflows), or nests includes deeper than 16 files; an empty
+     * string otherwise. @p open holds the files being read, outermost
+     * first.
+     */
+    std::string
+    include_cycle(const std::string &file_name, std::vector<std::string> open)
+    {
+      std::error_code   error;
+      const std::string canonical =
+        std::filesystem::weakly_canonical(file_name, error).string();
+      open.push_back(canonical);
+      std::ifstream in(file_name);
+      std::string   line;
+      for (unsigned int number = 1; std::getline(in, line); ++number)
+        if (const auto included =
+              after_keyword(without_comment(line), "include "))
+          {
+            const std::string at = file_name + ", line " +
+                                   std::to_string(number) + ": 'include " +
+                                   *included + "' ";
+            if (std::find(open.begin(),
+                          open.end(),
+                          std::filesystem::weakly_canonical(*included, error)
+                            .string()) != open.end())
+              return at + "includes a file that is being read: an include "
+                          "cycle";
+            if (open.size() >= 16)
+              return at + "nests includes more than 16 files deep";
+            if (const std::string cycle = include_cycle(*included, open);
+                !cycle.empty())
+              return cycle;
+          }
+      return "";
+    }
+
     /**
      * Why deal.II's parser refuses the @p statement of a parameter file, in
      * the subsections @p path, which a `subsection` or `end` statement
@@ -284,20 +348,9 @@ namespace membranes::Parameters
                     std::vector<std::string> &path,
                     std::string               statement)
     {
-      statement = statement.substr(0, statement.find('#'));
-      std::replace(statement.begin(), statement.end(), '\t', ' ');
-      statement = trim(statement);
-      // What follows the keyword at the start of the statement, if any.
-      const auto after =
-        [&statement](std::string keyword) -> std::optional<std::string> {
-        for (int capitals = 0; capitals < 2; ++capitals)
-          {
-            if (statement.rfind(keyword, 0) == 0)
-              return trim(statement.substr(keyword.size()));
-            for (char &c : keyword)
-              c = static_cast<char>(std::toupper(c));
-          }
-        return std::nullopt;
+      statement        = without_comment(statement);
+      const auto after = [&statement](const std::string &keyword) {
+        return after_keyword(statement, keyword);
       };
 
       if (statement.empty())
@@ -383,6 +436,8 @@ namespace membranes::Parameters
         !problem.empty())
       throw InputError(file_name + ": " + problem +
                        "; a scene is a parameter file 'name.prm'");
+    if (const std::string cycle = include_cycle(file_name, {}); !cycle.empty())
+      throw InputError(cycle);
     try
       {
         prm.parse_input(file_name, "", false, false);

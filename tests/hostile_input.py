@@ -306,6 +306,14 @@ def values():
     cases += [Case(name, scene=scene, expect=SUCCEED, settings=settings)
               for name, scene, settings in VALID_SCENES]
     cases += [
+        # deal.II's parser follows includes without a limit: a cycle would
+        # recurse until the stack overflows.
+        Case("a scene that includes itself", scene="include scene.prm\n",
+             words=["scene.prm, line 1", "include cycle"]),
+        Case("an include cycle through a second file",
+             scene="include other.prm\n",
+             files={"other.prm": b"subsection Problem\nend\ninclude scene.prm\n"},
+             words=["other.prm, line 3", "include cycle"]),
         Case("a 100 kB value", scene=section("Problem", f1="1" + "+1" * 50000),
              expect=EITHER, words=["Problem/f1"]),
         Case("Windows line ends",
