@@ -64,13 +64,21 @@ namespace membranes
         u[i].resize(n_q_points);
         laplacian[i].assign(n_q_points, 0.0);
       }
-    std::vector<double>         lambda(n_q_points);
+    std::vector<double> lambda(n_q_points);
+    // The nodal values of a cell, read into one buffer: the functions of
+    // FEValuesViews that take the global vector allocate an aligned vector
+    // on every call, which on a million cells fragments the heap so much
+    // that this loop used to set the peak memory of a run.
+    std::vector<double>         local_dofs(fe.n_dofs_per_cell());
     const std::array<double, 2> sign{{1., -1.}};
 
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
+          cell->get_dof_values(ghosted_solution,
+                               local_dofs.begin(),
+                               local_dofs.end());
           action.lambda_h_values(cell, lambda);
 
           const double h_K     = cell->diameter();
@@ -79,10 +87,12 @@ namespace membranes
           for (unsigned int i = 0; i < 2; ++i)
             {
               const FEValuesExtractors::Scalar membrane(i);
-              fe_values[membrane].get_function_values(ghosted_solution, u[i]);
+              fe_values[membrane].get_function_values_from_local_dof_values(
+                local_dofs, u[i]);
               if (with_laplacians)
-                fe_values[membrane].get_function_laplacians(ghosted_solution,
-                                                            laplacian[i]);
+                fe_values[membrane]
+                  .get_function_laplacians_from_local_dof_values(local_dofs,
+                                                                 laplacian[i]);
 
               // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
               // assembly.
@@ -130,6 +140,10 @@ namespace membranes
     // Quadrilaterals: the two traces on the edge, with matching points.
     std::unique_ptr<FEInterfaceValues<dim>>                   interface_values;
     std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
+    // The nodal values of a cell (and of its neighbour, side 1).
+    std::array<std::vector<double>, 2> local_dofs;
+    for (auto &values : local_dofs)
+      values.resize(fe.n_dofs_per_cell());
 
     if (fe.reference_cell().is_simplex())
       {
@@ -143,10 +157,14 @@ namespace membranes
           if (!cell->is_artificial())
             {
               fe_values.reinit(cell);
+              cell->get_dof_values(ghosted_solution,
+                                   local_dofs[0].begin(),
+                                   local_dofs[0].end());
               for (unsigned int i = 0; i < 2; ++i)
                 {
-                  fe_values[membrane[i]].get_function_gradients(
-                    ghosted_solution, gradient);
+                  fe_values[membrane[i]]
+                    .get_function_gradients_from_local_dof_values(local_dofs[0],
+                                                                  gradient);
                   cell_gradient[cell->active_cell_index()][i] = gradient[0];
                 }
             }
@@ -195,6 +213,12 @@ namespace membranes
                                      neighbor,
                                      cell->neighbor_of_neighbor(f),
                                      numbers::invalid_unsigned_int);
+          cell->get_dof_values(ghosted_solution,
+                               local_dofs[0].begin(),
+                               local_dofs[0].end());
+          neighbor->get_dof_values(ghosted_solution,
+                                   local_dofs[1].begin(),
+                                   local_dofs[1].end());
           const unsigned int    n_q = interface_values->n_quadrature_points;
           std::array<double, 2> integrals{};
           for (unsigned int i = 0; i < 2; ++i)
@@ -203,7 +227,8 @@ namespace membranes
                 {
                   traces[i][side].resize(n_q);
                   interface_values->get_fe_face_values(side)[membrane[i]]
-                    .get_function_gradients(ghosted_solution, traces[i][side]);
+                    .get_function_gradients_from_local_dof_values(
+                      local_dofs[side], traces[i][side]);
                 }
               for (unsigned int q = 0; q < n_q; ++q)
                 integrals[i] +=
