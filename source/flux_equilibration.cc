@@ -193,10 +193,10 @@ namespace membranes
   template <int dim>
   struct FluxReconstruction<dim>::PatchScratch
   {
-    std::vector<PatchKey>                             keys;
-    std::vector<std::pair<unsigned int, double>>      unknown_of;
-    std::vector<std::array<double, 2>>                source, known, mean;
-    std::vector<double>                               weight;
+    std::vector<PatchKey>                        keys;
+    std::vector<std::pair<unsigned int, double>> unknown_of;
+    std::vector<std::array<double, 2>>           source, known, mean, change;
+    std::vector<double>                          weight;
     std::vector<std::array<std::array<double, 3>, 2>> target;
     FullMatrix<double>                                matrix;
     std::array<Vector<double>, 2>                     rhs;
@@ -708,16 +708,25 @@ namespace membranes
 
     // The target: on each sub-triangle the RT0 field with the fluxes of
     // −μ_i φ_a ∇u_ih through its edges; through a half-edge shared by two
-    // cells, the mean of both sides. The targets are then conforming, and
-    // where u_ih is linear they satisfy the constraints: σ_ih^a is its
-    // target, and σ_ih = −μ_i ∇u_ih.
+    // cells, the mean of both sides. On the fine side of an edge with a
+    // hanging node, the two halves of a small edge share one unknown, so
+    // their targets take one density: the flux this moves between the two
+    // sub-triangles of the face goes back through their common edge 0
+    // (m_e–b_K), half of the difference of the changes from each side,
+    // which keeps the target conforming inside the cell. The targets are
+    // then conforming, and where u_ih is linear they satisfy the
+    // constraints (through a small edge the one-sided fluxes of the fine
+    // side add up to the coarse side's, so the two changes are opposite):
+    // σ_ih^a is its target, and σ_ih = −μ_i ∇u_ih, also with hanging nodes.
     auto &target = scratch.target;
     target.resize(n_sub);
     {
       auto &mean   = scratch.mean;
       auto &weight = scratch.weight;
+      auto &change = scratch.change;
       mean.assign(n_x, {});
       weight.assign(n_x, 0.);
+      change.resize(n_sub);
       for (unsigned int s = 0; s < n_sub; ++s)
         {
           for (unsigned int i = 0; i < 2; ++i)
@@ -734,9 +743,20 @@ namespace membranes
         for (unsigned int i = 0; i < 2; ++i)
           {
             const auto [x, f] = unknown_of[s];
-            target[s][i][2] =
+            const double flux =
               (x != invalid ? f * mean[x][i] / weight[x] : known[s][i]);
+            change[s][i]    = flux - target[s][i][2];
+            target[s][i][2] = flux;
           }
+      // ring[j] and ring[j + 1], j even, share edge 0 and lie on one face.
+      for (unsigned int s = 0; s < n_sub; s += 2)
+        if (std::abs(entry(s, factor)) == 0.5)
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              const double back = (change[s][i] - change[s + 1][i]) / 2;
+              target[s][i][0] -= back;
+              target[s + 1][i][0] += back;
+            }
     }
 
     // On cell c, with the outward fluxes b_j through the half-edges of its

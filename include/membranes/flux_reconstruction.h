@@ -114,9 +114,16 @@ namespace membranes
    * −μ_i φ_a ∇u_ih itself instead loses this: the sum of the patch
    * minimizers is then off by O(|∇u_ih|) in a strip of cells along ∂ω
    * and wherever the mesh changes direction, an effectivity that grows
-   * like h^{−1/2}.) At an edge with a hanging node the two halves on the
-   * fine side carry the same flux density (one unknown), which keeps
-   * σ_ih conforming but not exact for linear u_ih there.
+   * like h^{−1/2}.) At an edge with a hanging node the two halves of a
+   * small edge on the fine side carry one flux density (one unknown with
+   * the coarse side's half-edge), which keeps σ_ih conforming; T_ia
+   * differs there between the two halves, so its two fluxes are replaced
+   * by one density and what moves between the two sub-triangles of the
+   * face goes back through the edge m_e–b_K between them (half the
+   * difference of the two changes each way). Where u_ih is linear the two
+   * changes are opposite (the fine side's fluxes add up to the coarse
+   * side's), T_ia so changed is admissible, and σ_ih = −μ_i ∇u_ih exactly
+   * also with hanging nodes.
    *
    * The sum of the patch minimizers is not the field of RT0(S_h) with
    * this divergence that is closest to −μ_i ∇u_ih. Three sweeps of
