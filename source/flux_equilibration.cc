@@ -151,9 +151,12 @@ namespace membranes
     {
       enum Entry : unsigned int
       {
-        /** The key of the unknown flux through edge 2 (a point, x and y). */
-        key_x,
-        key_y,
+        /**
+         * The EdgeKey of the unknown flux through edge 2 (two global DoF
+         * indices, exact as doubles).
+         */
+        key_first,
+        key_second,
         /** Outward flux of κ through edge 2 = factor × the unknown. */
         factor,
         /** 1 if edge 2 lies on ∂ω, 0 otherwise. */
@@ -179,8 +182,8 @@ namespace membranes
     /** A half-edge of a patch problem, by its key, for sorting. */
     struct PatchKey
     {
-      double       x, y;
-      unsigned int cell, s;
+      types::global_dof_index first, second;
+      unsigned int            cell, s;
     };
   } // namespace
 
@@ -223,8 +226,8 @@ namespace membranes
         const SubTriangleData &kappa = sub_triangle_data[id];
         const PatchTerms      &terms = patch_terms[id];
 
-        record[key_x]               = terms.key[0];
-        record[key_y]               = terms.key[1];
+        record[key_first]           = terms.key[0];
+        record[key_second]          = terms.key[1];
         record[PatchRecord::factor] = terms.factor;
         record[on_boundary]         = terms.on_boundary ? 1 : 0;
         for (unsigned int k = 0, n = 0; k < 3; ++k)
@@ -647,9 +650,14 @@ namespace membranes
     keys.clear();
     for (unsigned int s = 0; s < n_sub; ++s)
       if (entry(s, on_boundary) == 0)
-        keys.push_back({entry(s, key_x), entry(s, key_y), s / n_ring, s});
+        keys.push_back(
+          {static_cast<types::global_dof_index>(entry(s, key_first)),
+           static_cast<types::global_dof_index>(entry(s, key_second)),
+           s / n_ring,
+           s});
     std::sort(keys.begin(), keys.end(), [](const auto &p, const auto &q) {
-      return std::tie(p.x, p.y, p.cell) < std::tie(q.x, q.y, q.cell);
+      return std::tie(p.first, p.second, p.cell) <
+             std::tie(q.first, q.second, q.cell);
     });
     auto &unknown_of = scratch.unknown_of;
     unknown_of.assign(n_sub, {invalid, 0.});
@@ -657,8 +665,8 @@ namespace membranes
     for (unsigned int begin = 0, end; begin < keys.size(); begin = end)
       {
         for (end = begin + 1;
-             end < keys.size() && keys[end].x == keys[begin].x &&
-             keys[end].y == keys[begin].y;
+             end < keys.size() && keys[end].first == keys[begin].first &&
+             keys[end].second == keys[begin].second;
              ++end)
           ;
         if (keys[end - 1].cell != keys[begin].cell)
