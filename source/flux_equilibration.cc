@@ -891,7 +891,9 @@ namespace membranes
     // The matrix of the minimization is positive definite, so that the
     // Cholesky factors of it and of the Schur complement of the
     // constraints solve the system; should round-off spoil that on a
-    // degenerate patch, LU with pivoting does.
+    // degenerate patch, LU with pivoting does. (LU of LAPACKFullMatrix on
+    // every patch takes 1.6 times the instructions: measured with
+    // callgrind on case M, 5 cycles on Q1 and 4 on P1.)
     if (!solve_saddle_point(matrix, n_x + n_cells, rhs, scratch.saddle_point))
       {
         LAPACKFullMatrix<double> lu(m, m);
