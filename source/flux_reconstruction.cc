@@ -91,24 +91,50 @@ namespace membranes
 
 
     /**
-     * The index of the coarse edge of which face @p f of @p cell is a half,
-     * when the neighbour there is coarser. (Found among the neighbour's
-     * faces: CellAccessor::neighbor_of_coarser_neighbor() fails on
-     * triangle meshes in deal.II 9.4.)
+     * The coarse edge of which face @p f of @p cell is a half, when the
+     * neighbour there is coarser. (Found among the neighbour's faces:
+     * CellAccessor::neighbor_of_coarser_neighbor() fails on triangle meshes
+     * in deal.II 9.4.)
      */
     template <typename CellIterator>
-    unsigned int
-    coarse_face_index(const CellIterator &cell, const unsigned int f)
+    auto
+    coarse_face(const CellIterator &cell, const unsigned int f)
     {
       const auto fine_face = cell->face(f);
       for (const auto &face : cell->neighbor(f)->face_iterators())
         if (face->has_children())
           for (unsigned int c = 0; c < face->n_children(); ++c)
             if (face->child(c) == fine_face)
-              return face->index();
+              return face;
       Assert(false, ExcInternalError());
-      return numbers::invalid_unsigned_int;
+      return fine_face;
     }
+
+
+
+    /** The EdgeKey of the whole edge @p edge. */
+    template <typename FaceIterator>
+    std::array<types::global_dof_index, 2>
+    edge_key(const FaceIterator &edge)
+    {
+      const auto p = edge->vertex_dof_index(0, 0);
+      const auto q = edge->vertex_dof_index(1, 0);
+      return {{std::min(p, q), std::max(p, q)}};
+    }
+
+
+
+    /** A hash of an EdgeKey. */
+    struct EdgeKeyHash
+    {
+      std::size_t
+      operator()(const std::array<types::global_dof_index, 2> &key) const
+      {
+        return std::hash<unsigned long long>()(
+          static_cast<unsigned long long>(key[0]) * 0x9e3779b97f4a7c15ull ^
+          key[1]);
+      }
+    };
 
 
 
@@ -276,9 +302,9 @@ namespace membranes
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
     sub_triangle_data.assign(n_cells * n_triangles, SubTriangleData());
-    std::unordered_map<unsigned long long, unsigned int> free_flux_index;
-    std::vector<FreeFlux<dim>>                           free_fluxes;
-    std::vector<std::pair<unsigned int, double>>         free_flux_of(n_cells *
+    std::unordered_map<EdgeKey, unsigned int, EdgeKeyHash> free_flux_index;
+    std::vector<FreeFlux<dim>>                             free_fluxes;
+    std::vector<std::pair<unsigned int, double>> free_flux_of(n_cells *
                                                               n_triangles);
     free_flux_index.reserve(n_cells * n_triangles);
     free_fluxes.reserve(n_cells * n_triangles);
@@ -347,52 +373,6 @@ namespace membranes
                       terms.boundary_length[k] = n_ds.norm();
                   }
 
-              // The unknown of the half-edge a–m_e in the patch problems:
-              // the half-edge itself, or on an edge with a hanging node the
-              // small edge that holds it (with factor 1 from the coarse
-              // side, 1/2 for each of the two half-edges on the fine side).
-              // Its key is the midpoint of that segment, computed alike on
-              // every cell and every process.
-              if (owned)
-                {
-                  const unsigned int f          = triangle.face;
-                  auto               face       = cell->face(f);
-                  double             factor     = 1;
-                  bool               small_edge = false;
-                  if (!cell->at_boundary(f) && face->has_children())
-                    {
-                      const unsigned int vertex =
-                        cell->vertex_index(triangle.vertex);
-                      const auto first = face->child(0);
-                      face = face->child(first->vertex_index(0) == vertex ||
-                                             first->vertex_index(1) == vertex ?
-                                           0 :
-                                           1);
-                      small_edge = true;
-                    }
-                  else if (!cell->at_boundary(f) &&
-                           cell->neighbor_is_coarser(f))
-                    {
-                      factor     = 0.5;
-                      small_edge = true;
-                    }
-                  Point<dim> first = face->vertex(0), second = face->vertex(1);
-                  if (std::make_pair(second[0], second[1]) <
-                      std::make_pair(first[0], first[1]))
-                    std::swap(first, second);
-                  const Point<dim> middle = (first + second) / 2;
-                  const Point<dim> key =
-                    small_edge ? middle :
-                                 (cell->vertex(triangle.vertex) + middle) / 2;
-                  terms.key         = {{key[0], key[1]}};
-                  terms.factor      = (cross_product_2d(second - first) *
-                                        (middle - cell->center()) >
-                                      0 ?
-                                         factor :
-                                         -factor);
-                  terms.on_boundary = cell->at_boundary(f);
-                }
-
               // The Gram matrix of the mapped basis ψ_k, (μ_i ∇u_ih, ψ_k),
               // the area, ∫ f_i, and the hat function terms on κ.
               for (unsigned int q = 0; q < points.n_volume; ++q)
@@ -445,21 +425,58 @@ namespace membranes
                       }
                   }
 
-              // The half-edge of κ: its unknown s, and the contribution of κ
-              // to the minimization, (−μ_i ∇u_ih − P_κ, ψ_κ) with ψ_κ = ψ_2.
+              // The unknowns of the half-edge a–m_e of κ, by their
+              // EdgeKey: in the minimization of t_ih the half-edge, or at an
+              // edge with a hanging vertex the whole coarse edge; in the
+              // patch problems the half-edge, or at a hanging vertex the
+              // small edge that holds it (with factor 1 from the coarse
+              // side, 1/2 for each of the two half-edges on the fine side).
               const unsigned int f    = triangle.face;
               const auto         face = cell->face(f);
-              unsigned long long key;
-              if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
-                key = 3ull * coarse_face_index(cell, f) + 2;
-              else if (face->has_children())
-                key = 3ull * face->index() + 2;
-              else
-                key = 3ull * face->index() +
-                      (face->vertex_index(0) ==
-                           cell->vertex_index(triangle.vertex) ?
-                         0 :
-                         1);
+              const auto         a = cell->vertex_dof_index(triangle.vertex, 0);
+              const auto         b = face->vertex_dof_index(
+                face->vertex_dof_index(0, 0) == a ? 1 : 0, 0);
+              EdgeKey key{{a, b}}, patch_key{{a, b}};
+              auto    patch_edge   = face;
+              double  patch_factor = 1;
+              if (!cell->at_boundary(f) && face->has_children())
+                {
+                  key                   = edge_key(face);
+                  const auto first_half = face->child(0);
+                  patch_edge = first_half->vertex_dof_index(0, 0) == a ||
+                                   first_half->vertex_dof_index(1, 0) == a ?
+                                 first_half :
+                                 face->child(1);
+                  patch_key  = edge_key(patch_edge);
+                }
+              else if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
+                {
+                  key          = edge_key(coarse_face(cell, f));
+                  patch_key    = edge_key(face);
+                  patch_factor = 0.5;
+                }
+              if (owned)
+                {
+                  // The patch unknown counts in the direction of
+                  // cross_product_2d() of its edge run from the end with the
+                  // smaller index, alike on both sides.
+                  const bool increasing = patch_edge->vertex_dof_index(0, 0) <
+                                          patch_edge->vertex_dof_index(1, 0);
+                  const Tensor<1, dim> along =
+                    patch_edge->vertex(increasing ? 1 : 0) -
+                    patch_edge->vertex(increasing ? 0 : 1);
+                  terms.key = patch_key;
+                  terms.factor =
+                    (cross_product_2d(along) *
+                           (patch_edge->center() - cell->center()) >
+                         0 ?
+                       patch_factor :
+                       -patch_factor);
+                  terms.on_boundary = cell->at_boundary(f);
+                }
+
+              // The contribution of κ to the minimization of its unknown s,
+              // (−μ_i ∇u_ih − P_κ, ψ_κ) with ψ_κ = ψ_2.
               Tensor<1, dim> normal =
                 cross_product_2d(face->vertex(1) - face->vertex(0));
               normal /= normal.norm();

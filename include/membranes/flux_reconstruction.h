@@ -114,9 +114,16 @@ namespace membranes
    * −μ_i φ_a ∇u_ih itself instead loses this: the sum of the patch
    * minimizers is then off by O(|∇u_ih|) in a strip of cells along ∂ω
    * and wherever the mesh changes direction, an effectivity that grows
-   * like h^{−1/2}.) At an edge with a hanging node the two halves on the
-   * fine side carry the same flux density (one unknown), which keeps
-   * σ_ih conforming but not exact for linear u_ih there.
+   * like h^{−1/2}.) At an edge with a hanging node the two halves of a
+   * small edge on the fine side carry one flux density (one unknown with
+   * the coarse side's half-edge), which keeps σ_ih conforming; T_ia
+   * differs there between the two halves, so its two fluxes are replaced
+   * by one density and what moves between the two sub-triangles of the
+   * face goes back through the edge m_e–b_K between them (half the
+   * difference of the two changes each way). Where u_ih is linear the two
+   * changes are opposite (the fine side's fluxes add up to the coarse
+   * side's), T_ia so changed is admissible, and σ_ih = −μ_i ∇u_ih exactly
+   * also with hanging nodes.
    *
    * The sum of the patch minimizers is not the field of RT0(S_h) with
    * this divergence that is closest to −μ_i ∇u_ih. Three sweeps of
@@ -146,9 +153,10 @@ namespace membranes
    * On several processes the support of a condensed φ_a can reach beyond
    * the ghost layer of a process that owns one of its cells. Each process
    * therefore writes, for its owned cells, what the patch problems need
-   * into records of plain numbers (with process-independent keys for the
-   * shared half-edges), sends them to the owner of a, which solves the
-   * patch problem and sends σ_ih^a back (Utilities::MPI::some_to_some).
+   * into records of plain numbers (with the half-edges named by the global
+   * DoF indices of their end vertices, the same on every process), sends them
+   * to the owner of a, which solves the patch problem and sends σ_ih^a back
+   * (Utilities::MPI::some_to_some).
    *
    * <h3>Quadrilaterals</h3>
    * The construction is the same on the pieces of Q1 cells, with the
@@ -243,6 +251,16 @@ namespace membranes
     data_names();
 
   private:
+    /**
+     * An edge or a half-edge of the mesh, by the global DoF indices (of
+     * u_1h) of its end vertices, which are exact and the same on every
+     * process: an edge by its two ends in increasing order, the half-edge
+     * a–m_e of the edge (a, b) by (a, b). (Two vertices end at most one
+     * edge, and an edge is named either whole or by its two halves, so
+     * names never meet.)
+     */
+    using EdgeKey = std::array<types::global_dof_index, 2>;
+
     /** What the reconstruction keeps of one sub-triangle κ. */
     struct SubTriangleData
     {
@@ -286,13 +304,13 @@ namespace membranes
       std::array<std::array<std::array<double, 2>, 3>, 2> edge_flux{};
       std::array<double, 2>                               boundary_length{};
       /**
-       * The key of the unknown flux through edge 2 of κ (a point), the
-       * factor that gives κ's outward flux from it, and whether edge 2
-       * lies on ∂ω (see write_patch_record()).
+       * The key of the unknown flux through edge 2 of κ, the factor that
+       * gives κ's outward flux from it, and whether edge 2 lies on ∂ω (see
+       * write_patch_record()).
        */
-      std::array<double, 2> key{};
-      double                factor      = 0;
-      bool                  on_boundary = false;
+      EdgeKey key{};
+      double  factor      = 0;
+      bool    on_boundary = false;
     };
 
     /** t̂ at the reference point @p x of sub-triangle @p s with @p fluxes. */
