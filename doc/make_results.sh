@@ -14,7 +14,7 @@
 # of the documents (doc/results.py splice), and the figures to doc/images/.
 # SECTIONS in the environment chooses what to make (default: all of
 # "readme tutorial benchmarks"); "benchmarks" runs every script of
-# benchmarks/ (about an hour on two cores, up to 12 GB of memory for
+# benchmarks/ (about half an hour on two cores, up to 9 GB of memory for
 # mpi_scaling.sh) and the tutorial quotes some of their tables, so it comes
 # first. The peer benchmark needs python3-dolfinx; without it its table is
 # left as it is and the script says so. The figures need python3-matplotlib.
@@ -48,12 +48,15 @@ quoted() {
   printf '%s' "$text"
 }
 
-# run COMMAND...: print it, run it, and remember it for the next block.
+# run COMMAND...: print it (on the script's standard error, also where the
+# command's output goes to a file), run it, and remember it for the next
+# block.
+exec 3>&2
 commands=()
 run() {
   local line
   line=$(quoted "$@")
-  echo "+ $line" >&2
+  echo "+ $line" >&3
   commands+=("$line")
   "$@"
 }
@@ -63,8 +66,9 @@ run() {
 benchmark() {
   local script=$1 out=$2 status=0
   shift 2
-  run env "$@" "benchmarks/$script" "$membranes" "$out" >"$out.log" 2>&1 ||
-    status=$?
+  local command=("benchmarks/$script" "$membranes" "$out")
+  (($# == 0)) || command=(env "$@" "${command[@]}")
+  run "${command[@]}" >"$out.log" 2>&1 || status=$?
   if ((status > 1)) || [[ ! -s $out/table.md ]]; then
     echo "make_results.sh: error: $script failed (status $status), see $out.log" >&2
     exit 1
@@ -103,8 +107,10 @@ figure() {
   echo "  -> doc/images/$2"
 }
 
+# The machine's state, and the last commit that changed the program (later
+# commits that change only documents do not count).
 machine() {
-  echo "On $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start, program built from commit $(git rev-parse --short HEAD)."
+  echo "On $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start, program built from commit $(git log -1 --format=%h -- source include CMakeLists.txt)."
 }
 
 for section in $sections; do
