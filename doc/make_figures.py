@@ -109,7 +109,8 @@ def run(membranes, scene, directory, settings):
     command = [membranes] + sum((["--set", s] for s in settings), []) + [
         "--set", "Output/Directory=" + directory,
         os.path.join(ROOT, "parameters", scene)]
-    print("$ " + " ".join("'%s'" % c if " " in c else c for c in command))
+    shown = command[:-1] + [os.path.relpath(command[-1])]
+    print("$ " + " ".join("'%s'" % c if " " in c else c for c in shown))
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
 
 
