@@ -557,23 +557,24 @@ namespace membranes::Parameters
     }
 
     /**
-     * The value of the Selection entry @p entry of the current subsection;
-     * its pattern, selection(@p choices), admits no other word.
+     * The value of the Selection entry @p path (`Subsection/Entry`, the
+     * current subsection's) in its enum. Its pattern, selection(@p choices),
+     * admits no other word, except a value that deal.II does not check (one
+     * with '{', which it keeps for its parameter loops): that one gets the
+     * usual error line, with the allowed words.
      */
     template <typename Enum>
     Enum
     selected(const ParameterHandler &prm,
-             const std::string      &entry,
+             const std::string      &path,
              const Choices<Enum>    &choices)
     {
-      const std::string word = prm.get(entry);
+      const std::string word = prm.get(path.substr(path.rfind('/') + 1));
       for (const auto &[name, value] : choices)
         if (name == word)
           return value;
-      AssertThrow(false,
-                  dealii::ExcMessage("'" + word + "' is not a word of " +
-                                     entry));
-      return choices.front().second;
+      throw invalid_entry(
+        path, word, "expected one of " + selection(choices).description());
     }
   } // namespace
 
@@ -613,13 +614,13 @@ namespace membranes::Parameters
   Geometry::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Geometry");
-    domain    = selected(prm, "Domain", domains);
+    domain    = selected(prm, "Geometry/Domain", domains);
     mesh_file = prm.get("Mesh file");
     if (domain == Domain::file && mesh_file.empty())
       throw invalid_entry("Geometry/Mesh file",
                           mesh_file,
                           "a Gmsh .msh file is needed when Domain = file");
-    cell_type          = selected(prm, "Cell type", cell_types);
+    cell_type          = selected(prm, "Geometry/Cell type", cell_types);
     initial_refinement = prm.get_integer("Initial refinement");
     prm.leave_subsection();
   }
@@ -783,11 +784,11 @@ namespace membranes::Parameters
   Solver::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Solver");
-    method                    = selected(prm, "Method", methods);
-    linear_solver             = selected(prm, "Linear solver", linear_solvers);
-    tolerance                 = get_double(prm, "Solver", "Tolerance");
+    method        = selected(prm, "Solver/Method", methods);
+    linear_solver = selected(prm, "Solver/Linear solver", linear_solvers);
+    tolerance     = get_double(prm, "Solver", "Tolerance");
     max_active_set_iterations = prm.get_integer("Max active set iterations");
-    stopping                  = selected(prm, "Stopping", stoppings);
+    stopping                  = selected(prm, "Solver/Stopping", stoppings);
     balance_fraction          = get_double(prm, "Solver", "Balance fraction");
     if (!(balance_fraction > 0 && balance_fraction < 1))
       throw invalid_entry("Solver/Balance fraction",
@@ -873,9 +874,9 @@ namespace membranes::Parameters
   Refinement::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    strategy       = selected(prm, "Strategy", strategies);
+    strategy       = selected(prm, "Refinement/Strategy", strategies);
     cycles         = prm.get_integer("Cycles");
-    marking        = selected(prm, "Marking", markings);
+    marking        = selected(prm, "Refinement/Marking", markings);
     bulk_parameter = get_double(prm, "Refinement", "Bulk parameter");
     if (!(bulk_parameter > 0))
       throw invalid_entry("Refinement/Bulk parameter",
@@ -889,7 +890,7 @@ namespace membranes::Parameters
                           "Bulk parameter + Coarsen fraction must be <= 1");
     minimum_growth   = get_double(prm, "Refinement", "Minimum growth");
     max_dofs         = prm.get_integer("Max dofs");
-    estimator        = selected(prm, "Estimator", estimators);
+    estimator        = selected(prm, "Refinement/Estimator", estimators);
     target_estimator = get_double(prm, "Refinement", "Target estimator");
     prm.leave_subsection();
   }

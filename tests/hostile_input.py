@@ -372,6 +372,9 @@ SCENE_ERRORS = [
      ["Problem", "line 2"]),
     ("include of a missing file", "include nothing-here.prm\n",
      ["nothing-here.prm"]),
+    # deal.II does not check a value with '{' against its pattern.
+    ("Domain = {square|disk}", section("Geometry", Domain="{square|disk}"),
+     ["Geometry/Domain", "square|lshape|slit|disk|file"]),
     ("binary scene",
      bytes(random.Random(7).randrange(256) for _ in range(300)), ["line"]),
     ("NUL bytes in a scene",
