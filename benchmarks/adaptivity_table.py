@@ -113,13 +113,13 @@ def run_table(name, rows):
     print()
 
 
-def rate(rows):
+def rate(rows, column="err_energy"):
     """(r, first cycle, last cycle): least-squares fit of
-    log err_energy = c - r log N over the last half of the cycles."""
-    points = [(math.log(number(r, "dofs")), math.log(number(r, "err_energy")),
+    log column = c - r log N over the last half of the cycles."""
+    points = [(math.log(number(r, "dofs")), math.log(number(r, column)),
                r["cycle"])
               for r in rows[len(rows) // 2:]
-              if (number(r, "err_energy") or 0) > 0]
+              if (number(r, column) or 0) > 0]
     if len(points) < 2:
         return None, None, None
     n = len(points)

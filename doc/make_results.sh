@@ -61,18 +61,31 @@ run() {
   "$@"
 }
 
-# benchmark SCRIPT OUTPUT-DIR [ENV=VALUE...]: one script of benchmarks/, whose
-# missed targets (exit status 1) do not stop this script.
+# benchmark BLOCK DIR SCRIPT [ENV=VALUE...]: one script of benchmarks/ into
+# <work-dir>/DIR, whose missed targets (exit status 1) do not stop this
+# script, and its table.md (of adaptivity.sh only the comparisons at equal
+# error) under the machine's state as block BLOCK of benchmarks/README.md.
 benchmark() {
-  local script=$1 out=$2 status=0
-  shift 2
+  local block=$1 out=$work/$2 script=$3 status=0 conditions
+  shift 3
   local command=("benchmarks/$script" "$membranes" "$out")
   (($# == 0)) || command=(env "$@" "${command[@]}")
+  commands=()
+  conditions=$(machine)
   run "${command[@]}" >"$out.log" 2>&1 || status=$?
   if ((status > 1)) || [[ ! -s $out/table.md ]]; then
     echo "make_results.sh: error: $script failed (status $status), see $out.log" >&2
     exit 1
   fi
+  {
+    echo "$conditions"
+    echo
+    if [[ $script == adaptivity.sh ]]; then
+      $python doc/results.py comparisons "$out/table.md"
+    else
+      cat "$out/table.md"
+    fi
+  } | block benchmarks/README.md "$block"
 }
 
 # membranes_run NAME SCENE [--set ...]: the program on a scene, without field
@@ -116,41 +129,17 @@ machine() {
 for section in $sections; do
   case $section in
   benchmarks)
-    commands=()
-    conditions=$(machine)
-    benchmark solver_cost.sh "$work/solver-cost"
-    { echo "$conditions"; echo; cat "$work/solver-cost/table.md"; } |
-      block benchmarks/README.md solver-cost
-
-    commands=()
-    conditions=$(machine)
-    benchmark solver_cost.sh "$work/solver-cost-balanced" STOPPING=balanced
-    { echo "$conditions"; echo; cat "$work/solver-cost-balanced/table.md"; } |
-      block benchmarks/README.md solver-cost-balanced
-
-    commands=()
-    conditions=$(machine)
-    benchmark adaptivity.sh "$work/adaptivity"
-    { echo "$conditions"; echo
-      $python doc/results.py comparisons "$work/adaptivity/table.md"; } |
-      block benchmarks/README.md adaptivity
+    benchmark solver-cost solver-cost solver_cost.sh
+    benchmark solver-cost-balanced solver-cost-balanced solver_cost.sh \
+      STOPPING=balanced
+    benchmark adaptivity adaptivity adaptivity.sh
     figure "$work/adaptivity/lshape-convergence.png" lshape-convergence.png
     figure "$work/adaptivity/slit-convergence.png" slit-convergence.png
-
     for script in flux_estimator flux_effectivity stability mpi_scaling; do
-      commands=()
-      conditions=$(machine)
-      benchmark "$script.sh" "$work/$script"
-      { echo "$conditions"; echo; cat "$work/$script/table.md"; } |
-        block benchmarks/README.md "${script//_/-}"
+      benchmark "${script//_/-}" "$script" "$script.sh"
     done
-
-    commands=()
     if $python -c "import dolfinx" 2>/dev/null; then
-      conditions=$(machine)
-      benchmark peer_snesvi.sh "$work/peer_snesvi"
-      { echo "$conditions"; echo; cat "$work/peer_snesvi/table.md"; } |
-        block benchmarks/README.md peer-snesvi
+      benchmark peer-snesvi peer_snesvi peer_snesvi.sh
     else
       echo "make_results.sh: python3-dolfinx is missing: the table of peer_snesvi.sh is left as it is" >&2
     fi

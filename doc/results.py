@@ -83,7 +83,8 @@ def markdown(header, rows, align):
 
 
 def short(x):
-    """Two significant digits, 0 as 0."""
+    """Three significant digits between 1e-3 and 1e3, two in exponent
+    notation outside, 0 as 0."""
     return "0" if x == 0 else f"{x:.3g}" if abs(x) >= 1e-3 and abs(x) < 1e3 \
         else f"{x:.1e}"
 
@@ -201,14 +202,9 @@ def estimators(arguments):
     table = []
     for path, label in labelled(arguments):
         rows = read_report(path)
-        half = rows[len(rows) // 2:]
-        x = [math.log(value(r, "dofs")) for r in half]
-        y = [math.log(value(r, "estimator")) for r in half]
-        mx, my = sum(x) / len(x), sum(y) / len(y)
-        slope = sum((a - mx) * (b - my) for a, b in zip(x, y)) / \
-            sum((a - mx) ** 2 for a in x)
+        rate, _, _ = adaptivity_table.rate(rows, "estimator")
         table.append([label, rows[-1]["cycle"], rows[-1]["dofs"],
-                      f"{value(rows[-1], 'estimator'):.3f}", f"{-slope:.2f}"])
+                      f"{value(rows[-1], 'estimator'):.3f}", f"{rate:.2f}"])
     return markdown(["run", "last cycle", "dofs", "estimator", "rate in N"],
                     table, "lrrrr")
 
