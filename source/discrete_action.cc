@@ -5,6 +5,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparsity_tools.h>
+#include <membranes/cell_loop.h>
 #include <membranes/cell_system.h>
 #include <membranes/discrete_action.h>
 
@@ -64,34 +65,57 @@ namespace membranes
     VectorType dual_cell_measure(locally_owned_dofs, mpi_communicator);
     VectorType stiffness_diagonal(locally_owned_dofs, mpi_communicator);
 
-    CellSystem<dim>    cell_system(discretization, data);
-    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
-    Vector<double>     local_stiffness(dofs_per_cell);
-    loads_per_cell = cell_system.n_load_entries();
+    // The cell loop on threads: each works with its own CellSystem, the
+    // loads of every cell go to that cell's own slot of loads_of_cells, and
+    // the copier adds the cell's matrix and vectors to the global ones.
+    struct CellContribution
+    {
+      FullMatrix<double>                   matrix;
+      Vector<double>                       rhs, lumped_mass, stiffness_diagonal;
+      std::vector<types::global_dof_index> dof_indices;
+    };
+    loads_per_cell = CellSystem<dim>(discretization, data).n_load_entries();
     loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
                             loads_per_cell,
                           0.);
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          cell_system.reinit(cell);
-          cell_system.copy_loads(
-            &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
-          for (unsigned int i = 0; i < dofs_per_cell; ++i)
-            {
-              const unsigned int v = cell_system.scalar_index_of(i);
-              local_stiffness(i)   = cell_system.laplace_matrix(v, v);
-            }
-          hanging_node_constraints.distribute_local_to_global(
-            cell_system.matrix, cell_system.dof_indices, stiffness_matrix);
-          hanging_node_constraints.distribute_local_to_global(
-            cell_system.rhs, cell_system.dof_indices, load_vector);
-          hanging_node_constraints.distribute_local_to_global(
-            cell_system.lumped_mass,
-            cell_system.dof_indices,
-            dual_cell_measure);
-          stiffness_diagonal.add(cell_system.dof_indices, local_stiffness);
-        }
+    run_on_cells<CellContribution>(
+      dof_handler,
+      [&]() { return std::make_unique<CellSystem<dim>>(discretization, data); },
+      [&](const auto       &cell,
+          CellSystem<dim>  &cell_system,
+          CellContribution &contribution) {
+        contribution.dof_indices.clear();
+        if (!cell->is_locally_owned())
+          return;
+        cell_system.reinit(cell);
+        cell_system.copy_loads(
+          &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
+        contribution.matrix      = cell_system.matrix;
+        contribution.rhs         = cell_system.rhs;
+        contribution.lumped_mass = cell_system.lumped_mass;
+        contribution.dof_indices = cell_system.dof_indices;
+        contribution.stiffness_diagonal.reinit(contribution.dof_indices.size());
+        for (unsigned int i = 0; i < contribution.dof_indices.size(); ++i)
+          {
+            const unsigned int v = cell_system.scalar_index_of(i);
+            contribution.stiffness_diagonal(i) =
+              cell_system.laplace_matrix(v, v);
+          }
+      },
+      [&](const CellContribution &contribution) {
+        if (contribution.dof_indices.empty())
+          return;
+        hanging_node_constraints.distribute_local_to_global(
+          contribution.matrix, contribution.dof_indices, stiffness_matrix);
+        hanging_node_constraints.distribute_local_to_global(
+          contribution.rhs, contribution.dof_indices, load_vector);
+        hanging_node_constraints.distribute_local_to_global(
+          contribution.lumped_mass,
+          contribution.dof_indices,
+          dual_cell_measure);
+        stiffness_diagonal.add(contribution.dof_indices,
+                               contribution.stiffness_diagonal);
+      });
     stiffness_matrix.compress(VectorOperation::add);
     load_vector.compress(VectorOperation::add);
     dual_cell_measure.compress(VectorOperation::add);

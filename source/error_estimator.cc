@@ -4,6 +4,7 @@
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_interface_values.h>
 #include <deal.II/fe/fe_values.h>
+#include <membranes/cell_loop.h>
 #include <membranes/error_estimator.h>
 
 namespace membranes
@@ -50,70 +51,79 @@ namespace membranes
     const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
     // derivatives, Q1 ones do on non-affine cells.
-    const bool         with_laplacians = !fe.reference_cell().is_simplex();
-    FEValues<dim>      fe_values(*discretization.mapping,
-                            fe,
-                            action.dual_quadrature().quadrature(),
-                            update_values | update_JxW_values |
-                              (with_laplacians ? update_hessians :
-                                                      update_default));
-    const unsigned int n_q_points = fe_values.n_quadrature_points;
-    std::array<std::vector<double>, 2> u, laplacian;
-    for (unsigned int i = 0; i < 2; ++i)
+    const bool with_laplacians = !fe.reference_cell().is_simplex();
+    struct Scratch
+    {
+      Scratch(const Discretization<dim> &discretization,
+              const DiscreteAction<dim> &action,
+              const bool                 with_laplacians)
+        : values(discretization,
+                 action,
+                 update_values | update_JxW_values |
+                   (with_laplacians ? update_hessians : update_default))
       {
-        u[i].resize(n_q_points);
-        laplacian[i].assign(n_q_points, 0.0);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            u[i].resize(values.fe_values.n_quadrature_points);
+            laplacian[i].assign(values.fe_values.n_quadrature_points, 0.0);
+          }
       }
-    std::vector<double> lambda(n_q_points);
-    // The nodal values of a cell, read into one buffer: the functions of
-    // FEValuesViews that take the global vector allocate an aligned vector
-    // on every call, which on a million cells fragments the heap so much
-    // that this loop used to set the peak memory of a run.
-    std::vector<double>         local_dofs(fe.n_dofs_per_cell());
+      DualCellValues<dim>                values;
+      std::array<std::vector<double>, 2> u, laplacian;
+    };
     const std::array<double, 2> sign{{1., -1.}};
 
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          fe_values.reinit(cell);
-          cell->get_dof_values(ghosted_solution,
-                               local_dofs.begin(),
-                               local_dofs.end());
-          action.lambda_h_values(cell, lambda);
+    // Each cell adds to its own indicator only: nothing to copy.
+    struct NoCopy
+    {};
+    run_on_cells<NoCopy>(
+      dof_handler,
+      [&]() {
+        return std::make_unique<Scratch>(discretization,
+                                         action,
+                                         with_laplacians);
+      },
+      [&](const auto &cell, Scratch &scratch, NoCopy &) {
+        if (!cell->is_locally_owned())
+          return;
+        scratch.values.reinit(cell, ghosted_solution);
+        const FEValues<dim>       &fe_values = scratch.values.fe_values;
+        const std::vector<double> &lambda    = scratch.values.lambda_h;
 
-          const double h_K     = cell->diameter();
-          double       eta2    = 0;
-          double       contact = 0;
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              const FEValuesExtractors::Scalar membrane(i);
-              fe_values[membrane].get_function_values_from_local_dof_values(
-                local_dofs, u[i]);
-              if (with_laplacians)
-                fe_values[membrane]
-                  .get_function_laplacians_from_local_dof_values(local_dofs,
-                                                                 laplacian[i]);
+        const double h_K     = cell->diameter();
+        double       eta2    = 0;
+        double       contact = 0;
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            const FEValuesExtractors::Scalar membrane(i);
+            fe_values[membrane].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs, scratch.u[i]);
+            if (with_laplacians)
+              fe_values[membrane].get_function_laplacians_from_local_dof_values(
+                scratch.values.local_dofs, scratch.laplacian[i]);
 
-              // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
-              // assembly.
-              const auto [f_mean, oscillation] =
-                action.load_mean_and_oscillation(cell, i);
+            // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
+            // assembly.
+            const auto [f_mean, oscillation] =
+              action.load_mean_and_oscillation(cell, i);
 
-              double residual = 0;
-              for (unsigned int q = 0; q < n_q_points; ++q)
-                residual += std::pow(f_mean + sign[i] * lambda[q] +
-                                       data.mu[i] * laplacian[i][q],
-                                     2) *
-                            fe_values.JxW(q);
-              eta2 += (h_K * h_K * residual +
-                       std::pow(h_K / numbers::PI, 2) * oscillation) /
-                      data.mu[i];
-            }
-          for (unsigned int q = 0; q < n_q_points; ++q)
-            contact += lambda[q] * (u[0][q] - u[1][q]) * fe_values.JxW(q);
-          indicators[cell->active_cell_index()] +=
-            eta2 + 2 * std::max(contact, 0.);
-        }
+            double residual = 0;
+            for (const unsigned int q : fe_values.quadrature_point_indices())
+              residual += std::pow(f_mean + sign[i] * lambda[q] +
+                                     data.mu[i] * scratch.laplacian[i][q],
+                                   2) *
+                          fe_values.JxW(q);
+            eta2 += (h_K * h_K * residual +
+                     std::pow(h_K / numbers::PI, 2) * oscillation) /
+                    data.mu[i];
+          }
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          contact +=
+            lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) * fe_values.JxW(q);
+        indicators[cell->active_cell_index()] +=
+          eta2 + 2 * std::max(contact, 0.);
+      },
+      [](const NoCopy &) {});
   }
 
 
@@ -128,23 +138,40 @@ namespace membranes
     const std::array<FEValuesExtractors::Scalar, 2> membrane{
       {FEValuesExtractors::Scalar(0), FEValuesExtractors::Scalar(1)}};
 
+    // What one thread needs on an edge: for quadrilaterals, the two traces
+    // on the edge, with matching points; the nodal values of a cell (and of
+    // its neighbour, side 1).
+    struct Scratch
+    {
+      std::unique_ptr<FEInterfaceValues<dim>> interface_values;
+      std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
+      std::array<std::vector<double>, 2>                        local_dofs;
+    };
+    const auto make_scratch = [&]() {
+      auto scratch = std::make_unique<Scratch>();
+      for (auto &values : scratch->local_dofs)
+        values.resize(fe.n_dofs_per_cell());
+      if (!fe.reference_cell().is_simplex())
+        scratch->interface_values =
+          std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
+                                                   fe,
+                                                   QGauss<dim - 1>(2),
+                                                   update_gradients |
+                                                     update_JxW_values |
+                                                     update_normal_vectors);
+      return scratch;
+    };
+
     // ∫_e |[μ_i ∂_n u_ih]|² for both membranes, on the edge that @p cell
     // shares with its neighbour through face @p f.
     std::function<std::array<double, 2>(
       const typename DoFHandler<dim>::active_cell_iterator &,
-      const unsigned int)>
+      const unsigned int,
+      Scratch &)>
       jump_integrals;
 
     // Triangles: P1 gradients are constant on each cell.
     std::vector<std::array<Tensor<1, dim>, 2>> cell_gradient;
-    // Quadrilaterals: the two traces on the edge, with matching points.
-    std::unique_ptr<FEInterfaceValues<dim>>                   interface_values;
-    std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
-    // The nodal values of a cell (and of its neighbour, side 1).
-    std::array<std::vector<double>, 2> local_dofs;
-    for (auto &values : local_dofs)
-      values.resize(fe.n_dofs_per_cell());
-
     if (fe.reference_cell().is_simplex())
       {
         cell_gradient.resize(dof_handler.get_triangulation().n_active_cells());
@@ -153,101 +180,109 @@ namespace membranes
                                 QGaussSimplex<dim>(1),
                                 update_gradients);
         std::vector<Tensor<1, dim>> gradient(1);
+        std::vector<double>         local_dofs(fe.n_dofs_per_cell());
         for (const auto &cell : dof_handler.active_cell_iterators())
           if (!cell->is_artificial())
             {
               fe_values.reinit(cell);
               cell->get_dof_values(ghosted_solution,
-                                   local_dofs[0].begin(),
-                                   local_dofs[0].end());
+                                   local_dofs.begin(),
+                                   local_dofs.end());
               for (unsigned int i = 0; i < 2; ++i)
                 {
                   fe_values[membrane[i]]
-                    .get_function_gradients_from_local_dof_values(local_dofs[0],
+                    .get_function_gradients_from_local_dof_values(local_dofs,
                                                                   gradient);
                   cell_gradient[cell->active_cell_index()][i] = gradient[0];
                 }
             }
-        jump_integrals = [&](const auto &cell, const unsigned int f) {
-          const auto           face    = cell->face(f);
-          const Tensor<1, dim> tangent = face->vertex(1) - face->vertex(0);
-          Tensor<1, dim>       normal  = cross_product_2d(tangent);
-          const double         length  = tangent.norm();
-          normal /= length;
-          if (normal * (face->center() - cell->center()) < 0)
-            normal *= -1;
-          const auto           &neighbor = cell->neighbor(f);
-          std::array<double, 2> integrals;
-          for (unsigned int i = 0; i < 2; ++i)
-            integrals[i] =
-              std::pow(data.mu[i] *
-                         (cell_gradient[cell->active_cell_index()][i] -
-                          cell_gradient[neighbor->active_cell_index()][i]) *
-                         normal,
-                       2) *
-              length;
-          return integrals;
-        };
+        jump_integrals =
+          [&](const auto &cell, const unsigned int f, Scratch &) {
+            const auto           face    = cell->face(f);
+            const Tensor<1, dim> tangent = face->vertex(1) - face->vertex(0);
+            Tensor<1, dim>       normal  = cross_product_2d(tangent);
+            const double         length  = tangent.norm();
+            normal /= length;
+            if (normal * (face->center() - cell->center()) < 0)
+              normal *= -1;
+            const auto           &neighbor = cell->neighbor(f);
+            std::array<double, 2> integrals;
+            for (unsigned int i = 0; i < 2; ++i)
+              integrals[i] =
+                std::pow(data.mu[i] *
+                           (cell_gradient[cell->active_cell_index()][i] -
+                            cell_gradient[neighbor->active_cell_index()][i]) *
+                           normal,
+                         2) *
+                length;
+            return integrals;
+          };
       }
     else
-      {
-        interface_values =
-          std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
-                                                   fe,
-                                                   QGauss<dim - 1>(2),
-                                                   update_gradients |
-                                                     update_JxW_values |
-                                                     update_normal_vectors);
-        jump_integrals = [&](const auto &cell, const unsigned int f) {
-          const auto &neighbor = cell->neighbor(f);
+      jump_integrals =
+        [&](const auto &cell, const unsigned int f, Scratch &scratch) {
+          FEInterfaceValues<dim> &interface_values = *scratch.interface_values;
+          const auto             &neighbor         = cell->neighbor(f);
           if (cell->neighbor_is_coarser(f))
             {
               const auto [nf, nsf] = cell->neighbor_of_coarser_neighbor(f);
-              interface_values->reinit(
+              interface_values.reinit(
                 cell, f, numbers::invalid_unsigned_int, neighbor, nf, nsf);
             }
           else
-            interface_values->reinit(cell,
-                                     f,
-                                     numbers::invalid_unsigned_int,
-                                     neighbor,
-                                     cell->neighbor_of_neighbor(f),
-                                     numbers::invalid_unsigned_int);
+            interface_values.reinit(cell,
+                                    f,
+                                    numbers::invalid_unsigned_int,
+                                    neighbor,
+                                    cell->neighbor_of_neighbor(f),
+                                    numbers::invalid_unsigned_int);
           cell->get_dof_values(ghosted_solution,
-                               local_dofs[0].begin(),
-                               local_dofs[0].end());
+                               scratch.local_dofs[0].begin(),
+                               scratch.local_dofs[0].end());
           neighbor->get_dof_values(ghosted_solution,
-                                   local_dofs[1].begin(),
-                                   local_dofs[1].end());
-          const unsigned int    n_q = interface_values->n_quadrature_points;
+                                   scratch.local_dofs[1].begin(),
+                                   scratch.local_dofs[1].end());
+          const unsigned int    n_q = interface_values.n_quadrature_points;
           std::array<double, 2> integrals{};
           for (unsigned int i = 0; i < 2; ++i)
             {
+              auto &traces = scratch.traces[i];
               for (unsigned int side = 0; side < 2; ++side)
                 {
-                  traces[i][side].resize(n_q);
-                  interface_values->get_fe_face_values(side)[membrane[i]]
+                  traces[side].resize(n_q);
+                  interface_values.get_fe_face_values(side)[membrane[i]]
                     .get_function_gradients_from_local_dof_values(
-                      local_dofs[side], traces[i][side]);
+                      scratch.local_dofs[side], traces[side]);
                 }
               for (unsigned int q = 0; q < n_q; ++q)
                 integrals[i] +=
-                  std::pow(data.mu[i] * (traces[i][0][q] - traces[i][1][q]) *
-                             interface_values->normal(q),
+                  std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
+                             interface_values.normal(q),
                            2) *
-                  interface_values->JxW(q);
+                  interface_values.JxW(q);
             }
           return integrals;
         };
-      }
 
     // Every interior edge once, from its finer side (or from the cell with
     // the smaller index between cells of the same level); half of the
-    // term goes to each of the two cells. Ghost cells take part, so that an
-    // edge between an owned and a ghost cell counts whichever side
-    // computes it (ghost cells' indicators are dropped later).
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (!cell->is_artificial())
+    // term goes to each of the two cells, in the copier. Ghost cells take
+    // part, so that an edge between an owned and a ghost cell counts
+    // whichever side computes it (ghost cells' indicators are dropped
+    // later).
+    struct EdgeTerm
+    {
+      unsigned int cell, neighbor;
+      double       term;
+    };
+    using EdgeTerms = std::vector<EdgeTerm>;
+    run_on_cells<EdgeTerms>(
+      dof_handler,
+      make_scratch,
+      [&](const auto &cell, Scratch &scratch, EdgeTerms &terms) {
+        terms.clear();
+        if (cell->is_artificial())
+          return;
         for (const unsigned int f : cell->face_indices())
           {
             if (cell->at_boundary(f))
@@ -257,13 +292,21 @@ namespace membranes
                 (!cell->neighbor_is_coarser(f) &&
                  neighbor->active_cell_index() < cell->active_cell_index()))
               continue;
-            const auto   integrals = jump_integrals(cell, f);
-            const double term =
-              0.5 * cell->face(f)->measure() *
-              (integrals[0] / data.mu[0] + integrals[1] / data.mu[1]);
-            indicators[cell->active_cell_index()] += term;
-            indicators[neighbor->active_cell_index()] += term;
+            const auto integrals = jump_integrals(cell, f, scratch);
+            terms.push_back(
+              {cell->active_cell_index(),
+               neighbor->active_cell_index(),
+               0.5 * cell->face(f)->measure() *
+                 (integrals[0] / data.mu[0] + integrals[1] / data.mu[1])});
           }
+      },
+      [&](const EdgeTerms &terms) {
+        for (const auto &[cell, neighbor, term] : terms)
+          {
+            indicators[cell] += term;
+            indicators[neighbor] += term;
+          }
+      });
   }
 
 

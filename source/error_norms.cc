@@ -1,6 +1,7 @@
 #include <cmath>
 #include <deal.II/base/mpi.h>
 #include <deal.II/fe/fe_values.h>
+#include <membranes/cell_loop.h>
 #include <membranes/error_norms.h>
 
 namespace membranes
@@ -21,63 +22,80 @@ namespace membranes
                            const DiscreteAction<dim> &action,
                            const MPI_Comm             mpi_communicator) const
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
-    FEValues<dim>             fe_values(*discretization.mapping,
-                            fe,
-                            action.dual_quadrature().quadrature(),
-                            update_values | update_gradients |
-                              update_quadrature_points | update_JxW_values);
-    const unsigned int        n_q_points = fe_values.n_quadrature_points;
-    std::array<std::vector<double>, 2>         uh, u;
-    std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
-    std::vector<double>                        lambda(n_q_points), lambda_h;
-    std::vector<bool>                          in_omega_h;
-    std::vector<double>                        local_dofs(fe.n_dofs_per_cell());
-    for (unsigned int i = 0; i < 2; ++i)
+    // What one thread needs on a cell: u_h, λ_h, u, λ and the gradients
+    // at the points of the dual-cell quadrature.
+    struct Scratch
+    {
+      Scratch(const Discretization<dim> &discretization,
+              const DiscreteAction<dim> &action)
+        : values(discretization,
+                 action,
+                 update_values | update_gradients | update_quadrature_points |
+                   update_JxW_values)
       {
-        uh[i].resize(n_q_points);
-        u[i].resize(n_q_points);
-        grad_uh[i].resize(n_q_points);
-        grad_u[i].resize(n_q_points);
+        const unsigned int n_q_points = values.fe_values.n_quadrature_points;
+        lambda.resize(n_q_points);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            uh[i].resize(n_q_points);
+            u[i].resize(n_q_points);
+            grad_uh[i].resize(n_q_points);
+            grad_u[i].resize(n_q_points);
+          }
       }
+      DualCellValues<dim>                        values;
+      std::array<std::vector<double>, 2>         uh, u;
+      std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
+      std::vector<double>                        lambda;
+    };
+    // Squared norms on one cell, and summed over the locally owned cells.
+    using Squares = std::array<double, 5>;
+    Squares squares{};
 
-    // Squared norms, summed over the locally owned cells.
-    std::array<double, 5> squares{};
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          fe_values.reinit(cell);
-          cell->get_dof_values(ghosted_solution,
-                               local_dofs.begin(),
-                               local_dofs.end());
-          action.lambda_h_values(cell, lambda_h, &in_omega_h);
-          data.set_gradient_step(1e-4 * cell->diameter());
-          const auto &points = fe_values.get_quadrature_points();
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              const FEValuesExtractors::Scalar membrane(i);
-              fe_values[membrane].get_function_values_from_local_dof_values(
-                local_dofs, uh[i]);
-              fe_values[membrane].get_function_gradients_from_local_dof_values(
-                local_dofs, grad_uh[i]);
-              data.exact_displacement(i).value_list(points, u[i]);
-              data.exact_displacement(i).gradient_list(points, grad_u[i]);
-            }
-          data.exact_lambda().value_list(points, lambda);
+    run_on_cells<Squares>(
+      dof_handler,
+      [&]() { return std::make_unique<Scratch>(discretization, action); },
+      [&](const auto &cell, Scratch &scratch, Squares &cell_squares) {
+        cell_squares = Squares{};
+        if (!cell->is_locally_owned())
+          return;
+        scratch.values.reinit(cell, ghosted_solution);
+        const FEValues<dim> &fe_values = scratch.values.fe_values;
+        data.set_gradient_step(1e-4 * cell->diameter());
+        const auto &points = fe_values.get_quadrature_points();
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            const FEValuesExtractors::Scalar membrane(i);
+            fe_values[membrane].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs, scratch.uh[i]);
+            fe_values[membrane].get_function_gradients_from_local_dof_values(
+              scratch.values.local_dofs, scratch.grad_uh[i]);
+            data.exact_displacement(i).value_list(points, scratch.u[i]);
+            data.exact_displacement(i).gradient_list(points, scratch.grad_u[i]);
+          }
+        data.exact_lambda().value_list(points, scratch.lambda);
 
-          for (unsigned int q = 0; q < n_q_points; ++q)
-            {
-              const double JxW = fe_values.JxW(q);
-              for (unsigned int i = 0; i < 2; ++i)
-                {
-                  squares[i] +=
-                    (grad_u[i][q] - grad_uh[i][q]).norm_square() * JxW;
-                  squares[2 + i] += std::pow(u[i][q] - uh[i][q], 2) * JxW;
-                }
-              if (in_omega_h[q])
-                squares[4] += std::pow(lambda[q] - lambda_h[q], 2) * JxW;
-            }
-        }
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          {
+            const double JxW = fe_values.JxW(q);
+            for (unsigned int i = 0; i < 2; ++i)
+              {
+                cell_squares[i] +=
+                  (scratch.grad_u[i][q] - scratch.grad_uh[i][q]).norm_square() *
+                  JxW;
+                cell_squares[2 + i] +=
+                  std::pow(scratch.u[i][q] - scratch.uh[i][q], 2) * JxW;
+              }
+            if (scratch.values.in_omega_h[q])
+              cell_squares[4] +=
+                std::pow(scratch.lambda[q] - scratch.values.lambda_h[q], 2) *
+                JxW;
+          }
+      },
+      [&](const Squares &cell_squares) {
+        for (unsigned int k = 0; k < squares.size(); ++k)
+          squares[k] += cell_squares[k];
+      });
 
     for (double &square : squares)
       square = std::sqrt(Utilities::MPI::sum(square, mpi_communicator));

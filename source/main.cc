@@ -58,7 +58,11 @@ main(int argc, char **argv)
   // (a Gmsh cell that names one vertex twice) that they do not check
   // otherwise.
   deal_II_exceptions::disable_abort_on_exception();
-  Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv, 1);
+  // The loops over cells outside the linear solver (data, errors,
+  // estimators) run on threads: as many per process as there are cores
+  // per process on the node (deal.II's default; DEAL_II_NUM_THREADS limits
+  // it).
+  Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv);
   const unsigned int process = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
   const bool         first_process = (process == 0);
   const unsigned int n_processes =

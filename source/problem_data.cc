@@ -3,6 +3,7 @@
 #include <cmath>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mu_parser_internal.h>
+#include <deal.II/base/thread_local_storage.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/grid/manifold.h>
 #include <membranes/problem_data.h>
@@ -193,8 +194,8 @@ namespace membranes
        * Expression @p c at the point that the variables are bound to: one
        * run of muparser's bytecode, with no lock and no lookup (unlike
        * FunctionParser::value(), which finds its parser in thread-local
-       * storage on every call; this program evaluates from one thread per
-       * process).
+       * storage on every call; Expression finds the parsers of its thread
+       * once for all the points of a cell).
        */
       double
       evaluate(const unsigned int c) const
@@ -256,6 +257,13 @@ namespace membranes
    * The gradient is given by a second entry when the scene has one (the
    * exact gradients of the displacements); otherwise it is the central
    * difference of the expression with the step of set_gradient_step().
+   *
+   * The loops over cells run on several threads (WorkStream), and a
+   * muparser object evaluates at the point its variables are bound to: so
+   * every thread has its own parsers and point, made on its first
+   * evaluation. They are found once per call of value_list() or
+   * gradient_list() (one lookup for all the points of a cell), not once
+   * per point.
    */
   template <int dim>
   class ProblemData<dim>::Expression : public Function<dim>
@@ -264,85 +272,151 @@ namespace membranes
     /**
      * The expression @p expression of entry @p entry, and, if
      * @p gradient_expression is not empty, its gradient from entry
-     * @p gradient_entry.
+     * @p gradient_entry. They are parsed here, so that a syntax error is an
+     * InputError on construction.
      */
     Expression(const std::string                   &entry,
                const std::string                   &expression,
                const std::map<std::string, double> &constants,
                const std::string                   &gradient_entry      = "",
                const std::string                   &gradient_expression = "")
-      : function(entry, expression, 1, constants, point)
+      : entry(entry)
+      , expression(expression)
+      , constants(constants)
+      , gradient_entry(gradient_entry)
+      , gradient_expression(gradient_expression)
     {
-      if (!Utilities::trim(gradient_expression).empty())
-        exact_gradient = std::make_unique<ParsedEntry<dim>>(
-          gradient_entry, gradient_expression, dim, constants, point);
+      parsers();
     }
-
-    /** The parsers hold the address of #point. */
-    Expression(const Expression &) = delete;
 
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
-      point               = p;
-      const double result = function.evaluate(0);
-      function.check(result, p, "value");
-      return result;
+      return parsers().value(p);
+    }
+
+    void
+    value_list(const std::vector<Point<dim>> &points,
+               std::vector<double>           &values,
+               const unsigned int = 0) const override
+    {
+      const ThreadParsers &local = parsers();
+      for (unsigned int q = 0; q < points.size(); ++q)
+        values[q] = local.value(points[q]);
     }
 
     Tensor<1, dim>
     gradient(const Point<dim> &p, const unsigned int = 0) const override
     {
-      Tensor<1, dim> gradient;
-      if (exact_gradient)
-        {
-          point = p;
-          for (unsigned int d = 0; d < dim; ++d)
-            gradient[d] = exact_gradient->evaluate(d);
-          static const char *const derivatives[] = {"derivative by x",
-                                                    "derivative by y",
-                                                    "derivative by z"};
-          for (unsigned int d = 0; d < dim; ++d)
-            exact_gradient->check(gradient[d], p, derivatives[d]);
-          return gradient;
-        }
-      // The central differences of deal.II's AutoDerivativeFunction
-      // (formula Euler), in the same arithmetic.
-      for (unsigned int d = 0; d < dim; ++d)
-        {
-          Tensor<1, dim> step;
-          step[d]              = step_size;
-          point                = p + step;
-          const double forward = function.evaluate(0);
-          point                = p - step;
-          gradient[d] = (forward - function.evaluate(0)) / (2 * step_size);
-        }
-      for (unsigned int d = 0; d < dim; ++d)
-        function.check(gradient[d], p, "gradient (by finite differences)");
-      return gradient;
+      return parsers().gradient(p);
     }
 
-    /** The step of the finite differences that give gradient(). */
     void
-    set_gradient_step(const double step)
+    gradient_list(const std::vector<Point<dim>> &points,
+                  std::vector<Tensor<1, dim>>   &gradients,
+                  const unsigned int = 0) const override
     {
-      step_size = step;
+      const ThreadParsers &local = parsers();
+      for (unsigned int q = 0; q < points.size(); ++q)
+        gradients[q] = local.gradient(points[q]);
+    }
+
+    /**
+     * The step of the finite differences that give gradient(), on the
+     * calling thread.
+     */
+    void
+    set_gradient_step(const double step) const
+    {
+      parsers().step_size = step;
     }
 
     /** The InputError for this entry, which should be @p allowed. */
     Parameters::InputError
     invalid(const std::string &allowed) const
     {
-      return function.invalid(allowed);
+      return parsers().function.invalid(allowed);
     }
 
   private:
-    /** The variables x, y of every expression. */
-    mutable Point<dim> point;
+    /** The parsers of one thread, bound to that thread's point. */
+    struct ThreadParsers
+    {
+      explicit ThreadParsers(const Expression &e)
+        : function(e.entry, e.expression, 1, e.constants, point)
+      {
+        if (!Utilities::trim(e.gradient_expression).empty())
+          exact_gradient = std::make_unique<ParsedEntry<dim>>(
+            e.gradient_entry, e.gradient_expression, dim, e.constants, point);
+      }
 
-    ParsedEntry<dim>                  function;
-    std::unique_ptr<ParsedEntry<dim>> exact_gradient;
-    double                            step_size = 1e-5;
+      /** The parsers hold the address of #point. */
+      ThreadParsers(const ThreadParsers &) = delete;
+
+      double
+      value(const Point<dim> &p) const
+      {
+        point               = p;
+        const double result = function.evaluate(0);
+        function.check(result, p, "value");
+        return result;
+      }
+
+      Tensor<1, dim>
+      gradient(const Point<dim> &p) const
+      {
+        Tensor<1, dim> gradient;
+        if (exact_gradient)
+          {
+            point = p;
+            for (unsigned int d = 0; d < dim; ++d)
+              gradient[d] = exact_gradient->evaluate(d);
+            static const char *const derivatives[] = {"derivative by x",
+                                                      "derivative by y",
+                                                      "derivative by z"};
+            for (unsigned int d = 0; d < dim; ++d)
+              exact_gradient->check(gradient[d], p, derivatives[d]);
+            return gradient;
+          }
+        // The central differences of deal.II's AutoDerivativeFunction
+        // (formula Euler), in the same arithmetic.
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            Tensor<1, dim> step;
+            step[d]              = step_size;
+            point                = p + step;
+            const double forward = function.evaluate(0);
+            point                = p - step;
+            gradient[d] = (forward - function.evaluate(0)) / (2 * step_size);
+          }
+        for (unsigned int d = 0; d < dim; ++d)
+          function.check(gradient[d], p, "gradient (by finite differences)");
+        return gradient;
+      }
+
+      /** The variables x, y of every expression. */
+      mutable Point<dim> point;
+
+      ParsedEntry<dim>                  function;
+      std::unique_ptr<ParsedEntry<dim>> exact_gradient;
+      double                            step_size = 1e-5;
+    };
+
+    /** The parsers of the calling thread, made on its first call. */
+    ThreadParsers &
+    parsers() const
+    {
+      std::shared_ptr<ThreadParsers> &local = thread_parsers.get();
+      if (!local)
+        local = std::make_shared<ThreadParsers>(*this);
+      return *local;
+    }
+
+    const std::string                   entry, expression;
+    const std::map<std::string, double> constants;
+    const std::string                   gradient_entry, gradient_expression;
+    mutable Threads::ThreadLocalStorage<std::shared_ptr<ThreadParsers>>
+      thread_parsers;
   };
 
 

@@ -266,6 +266,47 @@ namespace membranes
     double                                              max_force;
     double                                              l2_force;
   };
+
+
+
+  /**
+   * What a loop over cells reads on a cell at the points of the dual-cell
+   * quadrature: FEValues with @p update_flags, the nodal values of the
+   * solution (read into one buffer: the functions of FEValuesViews that take
+   * the global vector allocate an aligned vector on every call, which on a
+   * million cells fragments the heap), and λ_h with the points that lie in
+   * ω_h. The error norms and the estimators hold one per thread.
+   */
+  template <int dim>
+  struct DualCellValues
+  {
+    DualCellValues(const Discretization<dim> &discretization,
+                   const DiscreteAction<dim> &action,
+                   const UpdateFlags          update_flags)
+      : fe_values(*discretization.mapping,
+                  *discretization.fe,
+                  action.dual_quadrature().quadrature(),
+                  update_flags)
+      , local_dofs(discretization.fe->n_dofs_per_cell())
+      , action(action)
+    {}
+
+    /** Reinit on @p cell, with the nodal values of @p solution there. */
+    void
+    reinit(const typename DoFHandler<dim>::active_cell_iterator &cell,
+           const TrilinosWrappers::MPI::Vector                  &solution)
+    {
+      fe_values.reinit(cell);
+      cell->get_dof_values(solution, local_dofs.begin(), local_dofs.end());
+      action.lambda_h_values(cell, lambda_h, &in_omega_h);
+    }
+
+    FEValues<dim>              fe_values;
+    std::vector<double>        local_dofs;
+    std::vector<double>        lambda_h;
+    std::vector<bool>          in_omega_h;
+    const DiscreteAction<dim> &action;
+  };
 } // namespace membranes
 
 #endif

@@ -21,11 +21,12 @@ namespace membranes
    * `mu1`, `mu2`, `pi`, so that a manufactured solution written in terms of
    * the tensions stays exact for any μ1, μ2. The expressions are evaluated
    * by muparser directly, set up as FunctionParser sets it up (the same
-   * values to the last bit), without FunctionParser's lookup of a parser
-   * per thread on every evaluation. Expressions are parsed and evaluated
-   * once on construction; one that does not parse is an InputError naming
-   * its entry. Every value is checked where the program evaluates it: one
-   * that is not finite, or larger than Parameters::max_magnitude in
+   * values to the last bit), one set of parsers per thread, looked up once
+   * per list of points (a cell's quadrature points), not, as
+   * FunctionParser does, on every evaluation. Expressions are parsed and
+   * evaluated once on construction; one that does not parse is an InputError
+   * naming its entry. Every value is checked where the program evaluates it:
+   * one that is not finite, or larger than Parameters::max_magnitude in
    * magnitude, is an InputError naming the entry and the point.
    *
    * The gradients of the exact displacements (for the H1 errors) are the
@@ -85,7 +86,8 @@ namespace membranes
      * The error norms set it relative to the cell they integrate over, so
      * that the difference stencil never leaves the neighbourhood of the
      * cell, however fine the mesh (near a re-entrant corner, a fixed step
-     * would reach across the corner).
+     * would reach across the corner). The step holds for the calling
+     * thread: each thread of a loop over cells sets its own.
      */
     void
     set_gradient_step(const double step) const;
