@@ -321,66 +321,85 @@ namespace membranes
     Vector<double>                &indicators,
     const MPI_Comm                 mpi_communicator) const
   {
-    const auto        &quadrature = action.dual_quadrature().quadrature();
-    FEValues<dim>      fe_values(*discretization.mapping,
-                            *discretization.fe,
-                            quadrature,
-                            update_values | update_gradients |
-                              update_jacobians | update_JxW_values);
-    const unsigned int n_q_points = quadrature.size();
-    std::array<std::vector<double>, 2>         u;
-    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
-    std::vector<Tensor<1, dim>>                flux;
-    std::vector<double>                        divergence, lambda;
-    for (unsigned int i = 0; i < 2; ++i)
+    struct Scratch
+    {
+      Scratch(const Discretization<dim> &discretization,
+              const DiscreteAction<dim> &action)
+        : values(discretization,
+                 action,
+                 update_values | update_gradients | update_jacobians |
+                   update_JxW_values)
       {
-        u[i].resize(n_q_points);
-        grad_u[i].resize(n_q_points);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            u[i].resize(values.fe_values.n_quadrature_points);
+            grad_u[i].resize(values.fe_values.n_quadrature_points);
+          }
       }
+      DualCellValues<dim>                        values;
+      std::array<std::vector<double>, 2>         u;
+      std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+      std::vector<Tensor<1, dim>>                flux;
+      std::vector<double>                        divergence, lambda;
+    };
     const std::array<double, 2> sign{{1., -1.}};
 
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
+    // η_F,i,K², η_R,i,K² and (λ_h, w_h)⁺_K of a cell; their sums
     // Σ_K η_F,i,K², Σ_K η_R,i,K² and B = Σ_K (λ_h, w_h)⁺_K on this process.
-    std::array<double, 5> sums{};
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          fe_values.reinit(cell);
-          action.nodal_lambda_values(fe_values, lambda);
-          const double h_K  = cell->diameter();
-          double       eta2 = 0;
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              const FEValuesExtractors::Scalar membrane(i);
-              fe_values[membrane].get_function_values(ghosted_solution, u[i]);
-              fe_values[membrane].get_function_gradients(ghosted_solution,
-                                                         grad_u[i]);
-              flux_reconstruction.flux_values(
-                cell, i, fe_values, flux, divergence);
-              const auto load      = flux_reconstruction.load_values(cell, i);
-              double     flux_term = 0, residual = 0;
-              for (unsigned int q = 0; q < n_q_points; ++q)
-                {
-                  flux_term +=
-                    (data.mu[i] * grad_u[i][q] + flux[q]).norm_square() *
-                    fe_values.JxW(q);
-                  residual +=
-                    std::pow(load[q] + sign[i] * lambda[q] - divergence[q], 2) *
-                    fe_values.JxW(q);
-                }
-              flux_term /= data.mu[i];
-              residual *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
-              sums[2 * i] += flux_term;
-              sums[2 * i + 1] += residual;
-              eta2 += std::pow(std::sqrt(flux_term) + std::sqrt(residual), 2);
-            }
-          double contact = 0;
-          for (unsigned int q = 0; q < n_q_points; ++q)
-            contact += lambda[q] * (u[0][q] - u[1][q]) * fe_values.JxW(q);
-          contact = std::max(contact, 0.);
-          sums[4] += contact;
-          indicators[cell->active_cell_index()] = eta2 + 2 * contact;
-        }
+    using Sums = std::array<double, 5>;
+    Sums sums{};
+    run_on_cells<Sums>(
+      dof_handler,
+      [&]() { return std::make_unique<Scratch>(discretization, action); },
+      [&](const auto &cell, Scratch &scratch, Sums &cell_sums) {
+        cell_sums = Sums{};
+        if (!cell->is_locally_owned())
+          return;
+        scratch.values.reinit(cell, ghosted_solution);
+        const FEValues<dim> &fe_values = scratch.values.fe_values;
+        action.nodal_lambda_values(fe_values, scratch.lambda);
+        const double h_K  = cell->diameter();
+        double       eta2 = 0;
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            const FEValuesExtractors::Scalar membrane(i);
+            fe_values[membrane].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs, scratch.u[i]);
+            fe_values[membrane].get_function_gradients_from_local_dof_values(
+              scratch.values.local_dofs, scratch.grad_u[i]);
+            flux_reconstruction.flux_values(
+              cell, i, fe_values, scratch.flux, scratch.divergence);
+            const auto load      = flux_reconstruction.load_values(cell, i);
+            double     flux_term = 0, residual = 0;
+            for (const unsigned int q : fe_values.quadrature_point_indices())
+              {
+                flux_term +=
+                  (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
+                    .norm_square() *
+                  fe_values.JxW(q);
+                residual += std::pow(load[q] + sign[i] * scratch.lambda[q] -
+                                       scratch.divergence[q],
+                                     2) *
+                            fe_values.JxW(q);
+              }
+            flux_term /= data.mu[i];
+            residual *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
+            cell_sums[2 * i]     = flux_term;
+            cell_sums[2 * i + 1] = residual;
+            eta2 += std::pow(std::sqrt(flux_term) + std::sqrt(residual), 2);
+          }
+        double contact = 0;
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
+                     fe_values.JxW(q);
+        cell_sums[4]                          = std::max(contact, 0.);
+        indicators[cell->active_cell_index()] = eta2 + 2 * cell_sums[4];
+      },
+      [&](const Sums &cell_sums) {
+        for (unsigned int k = 0; k < sums.size(); ++k)
+          sums[k] += cell_sums[k];
+      });
 
     for (double &sum : sums)
       sum = Utilities::MPI::sum(sum, mpi_communicator);
