@@ -16,7 +16,10 @@
 # "readme tutorial benchmarks"); "benchmarks" runs every script of
 # benchmarks/ (about half an hour on two cores, up to 9 GB of memory for
 # mpi_scaling.sh) and the tutorial quotes some of their tables, so it comes
-# first. The peer benchmark needs python3-dolfinx; without it its table is
+# first. BLOCKS in the environment limits the section benchmarks to the
+# blocks of benchmarks/README.md it names (e.g. BLOCKS="solver-cost
+# flux-estimator"); the others, and the tutorial's quotes of them, are left
+# as they are. The peer benchmark needs python3-dolfinx; without it its table is
 # left as it is and the script says so. The figures need python3-matplotlib.
 #
 # A benchmark that misses one of its targets exits with status 1; its table
@@ -68,6 +71,7 @@ run() {
 benchmark() {
   local block=$1 out=$work/$2 script=$3 status=0 conditions
   shift 3
+  chosen "$block" || return 0
   local command=("benchmarks/$script" "$membranes" "$out")
   (($# == 0)) || command=(env "$@" "${command[@]}")
   commands=()
@@ -86,6 +90,11 @@ benchmark() {
       cat "$out/table.md"
     fi
   } | block benchmarks/README.md "$block"
+}
+
+# chosen BLOCK: whether BLOCKS (all blocks if unset) names BLOCK.
+chosen() {
+  [[ -z ${BLOCKS:-} || " $BLOCKS " == *" $1 "* ]]
 }
 
 # membranes_run NAME SCENE [--set ...]: the program on a scene, without field
@@ -133,15 +142,19 @@ for section in $sections; do
     benchmark solver-cost-balanced solver-cost-balanced solver_cost.sh \
       STOPPING=balanced
     benchmark adaptivity adaptivity adaptivity.sh
-    figure "$work/adaptivity/lshape-convergence.png" lshape-convergence.png
-    figure "$work/adaptivity/slit-convergence.png" slit-convergence.png
+    if chosen adaptivity; then
+      figure "$work/adaptivity/lshape-convergence.png" lshape-convergence.png
+      figure "$work/adaptivity/slit-convergence.png" slit-convergence.png
+    fi
     for script in flux_estimator flux_effectivity stability mpi_scaling; do
       benchmark "${script//_/-}" "$script" "$script.sh"
     done
-    if $python -c "import dolfinx" 2>/dev/null; then
-      benchmark peer-snesvi peer_snesvi peer_snesvi.sh
-    else
-      echo "make_results.sh: python3-dolfinx is missing: the table of peer_snesvi.sh is left as it is" >&2
+    if chosen peer-snesvi; then
+      if $python -c "import dolfinx" 2>/dev/null; then
+        benchmark peer-snesvi peer_snesvi peer_snesvi.sh
+      else
+        echo "make_results.sh: python3-dolfinx is missing: the table of peer_snesvi.sh is left as it is" >&2
+      fi
     fi
     ;;
 
