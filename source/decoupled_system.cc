@@ -328,5 +328,23 @@ namespace membranes
 
 
 
+  template <int dim>
+  void
+  DecoupledSystem<dim>::clear()
+  {
+    ActiveSetSystem<dim>::clear();
+    laplace_matrix.clear();
+    preconditioner_matrix.clear();
+    for (VectorType *vector : {&sum_rhs, &difference_rhs, &sum, &difference})
+      vector->clear();
+    sum_constraints.clear();
+    difference_constraints.clear();
+    membrane_dofs = {};
+    scalar_dof    = {};
+    scalar_dof_handler.clear();
+  }
+
+
+
   template class DecoupledSystem<2>;
 } // namespace membranes
