@@ -610,7 +610,7 @@ namespace membranes
         if (balanced && (n_changes == 0 || *statistics.linearization_estimate +
                                                *statistics.algebraic_estimate <=
                                              balance))
-          return statistics;
+          break;
 
         const std::string reached =
           "relative KKT residual " + format(statistics.kkt_residual) +
@@ -618,7 +618,7 @@ namespace membranes
         if (n_changes == 0)
           {
             if (statistics.kkt_residual <= parameters.tolerance)
-              return statistics;
+              break;
             if (statistics.kkt_residual >= settled_residual)
               throw ActiveSetNotConverged(
                 "the active set method stalls after " +
@@ -654,6 +654,10 @@ namespace membranes
             active_set = step.active_set;
           }
       }
+    // The matrices and the AMG hierarchy of this mesh are not needed any
+    // more.
+    system->clear();
+    return statistics;
   }
 
 

@@ -37,6 +37,17 @@ namespace membranes
 
   template <int dim>
   void
+  ActiveSetSystem<dim>::clear()
+  {
+    system_matrix.clear();
+    system_rhs.clear();
+    linear_solver.clear();
+  }
+
+
+
+  template <int dim>
+  void
   ActiveSetSystem<dim>::make_mesh_constraints(
     const DoFHandler<dim>     &dof_handler,
     const Function<dim>       &boundary_values,

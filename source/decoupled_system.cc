@@ -169,6 +169,9 @@ namespace membranes
                                locally_relevant_scalar_dofs);
     laplace_matrix.reinit(this->system_matrix);
     preconditioner_matrix.reinit(this->system_matrix);
+    // The matrix of W of an iteration that reuses the AMG hierarchy is made
+    // by solve() when it is first needed, after the hierarchy is built.
+    this->system_matrix.clear();
     sum_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     difference_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     sum.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
@@ -282,11 +285,19 @@ namespace membranes
 
     // The system of W: μ̄ A and the loads of the mesh, with the rows and
     // columns of the active vertices eliminated (the constraints W_a = 0
-    // condensed, as AffineConstraints would do it in the assembly).
+    // condensed, as AffineConstraints would do it in the assembly). An
+    // iteration that builds the AMG hierarchy writes its matrix into
+    // preconditioner_matrix, which the hierarchy refers to for the rest of
+    // the mesh; one that reuses the hierarchy writes into system_matrix.
+    const bool builds_preconditioner = !this->has_mesh_preconditioner();
+    TrilinosWrappers::SparseMatrix &matrix =
+      builds_preconditioner ? preconditioner_matrix : this->system_matrix;
+    if (matrix.m() == 0)
+      matrix.reinit(laplace_matrix);
     eliminate_rows_and_columns(laplace_matrix,
                                this->data.mu_bar,
                                active_scalar_dofs,
-                               this->system_matrix);
+                               matrix);
     this->system_rhs = difference_rhs;
     set_active_to_zero(this->system_rhs);
     set_active_to_zero(difference);
@@ -295,9 +306,7 @@ namespace membranes
 
     // The AMG hierarchy of the system of an earlier iteration on this mesh
     // preconditions this one: the two differ near the free boundary only.
-    if (!this->has_mesh_preconditioner())
-      preconditioner_matrix.copy_from(this->system_matrix);
-    this->solve_linear_system(this->system_matrix,
+    this->solve_linear_system(matrix,
                               this->system_rhs,
                               difference_constraints,
                               difference,
@@ -315,6 +324,24 @@ namespace membranes
         solution[membrane_dofs[j][1]] = (sum[k] - mu1 * difference[k]) / M;
       }
     solution.compress(VectorOperation::insert);
+  }
+
+
+
+  template <int dim>
+  void
+  DecoupledSystem<dim>::clear()
+  {
+    ActiveSetSystem<dim>::clear();
+    laplace_matrix.clear();
+    preconditioner_matrix.clear();
+    for (VectorType *vector : {&sum_rhs, &difference_rhs, &sum, &difference})
+      vector->clear();
+    sum_constraints.clear();
+    difference_constraints.clear();
+    membrane_dofs = {};
+    scalar_dof    = {};
+    scalar_dof_handler.clear();
   }
 
 

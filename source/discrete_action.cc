@@ -173,13 +173,6 @@ namespace membranes
       for (unsigned int i = 0; i < 2; ++i)
         local_positions[k][i] =
           map.LID(static_cast<long long>(interior_vertices[k].dof[i]));
-
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        lambda_i[i].assign(interior_vertices.size(), 0.0);
-        stiffness_terms[i].assign(interior_vertices.size(), 0.0);
-        load_terms[i].assign(interior_vertices.size(), 0.0);
-      }
   }
 
 
@@ -211,14 +204,10 @@ namespace membranes
             const int    position  = local_positions[k][i];
             const double stiffness = products[position];
             const double load      = loads[position];
-            const double sign      = (i == 0 ? 1. : -1.);
-            lambda_i[i][k] = sign * (stiffness - load) / a.dual_cell_measure;
-            stiffness_terms[i][k] = stiffness;
-            load_terms[i][k]      = load;
-            const double size     = std::max(
+            const double size      = std::max(
               {std::abs(stiffness),
-                   std::abs(load),
-                   data.mu[i] * a.stiffness_diagonal * std::abs(values[position])});
+                    std::abs(load),
+                    data.mu[i] * a.stiffness_diagonal * std::abs(values[position])});
             local_max = std::max(local_max, size);
             local_sum_of_squares += size * size;
           }
@@ -298,7 +287,9 @@ namespace membranes
   DiscreteAction<dim>::lambda_from_membrane(const unsigned int i,
                                             const unsigned int k) const
   {
-    return lambda_i[i][k];
+    const double sign = (i == 0 ? 1. : -1.);
+    return sign * (stiffness_term(i, k) - load_term(i, k)) /
+           interior_vertices[k].dual_cell_measure;
   }
 
 
@@ -308,7 +299,7 @@ namespace membranes
   DiscreteAction<dim>::stiffness_term(const unsigned int i,
                                       const unsigned int k) const
   {
-    return stiffness_terms[i][k];
+    return stiffness_product.trilinos_vector()[0][local_positions[k][i]];
   }
 
 
@@ -318,7 +309,7 @@ namespace membranes
   DiscreteAction<dim>::load_term(const unsigned int i,
                                  const unsigned int k) const
   {
-    return load_terms[i][k];
+    return load_vector.trilinos_vector()[0][local_positions[k][i]];
   }
 
 
@@ -327,7 +318,7 @@ namespace membranes
   double
   DiscreteAction<dim>::lambda(const unsigned int k) const
   {
-    return (lambda_i[0][k] + lambda_i[1][k]) / 2;
+    return (lambda_from_membrane(0, k) + lambda_from_membrane(1, k)) / 2;
   }
 
 

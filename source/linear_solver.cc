@@ -73,6 +73,15 @@ namespace membranes
 
 
   template <int dim>
+  void
+  LinearSolver<dim>::clear()
+  {
+    amg.reset();
+  }
+
+
+
+  template <int dim>
   std::string
   LinearSolver<dim>::method() const
   {

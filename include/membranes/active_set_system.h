@@ -106,6 +106,15 @@ namespace membranes
           const double               tolerance,
           ActiveSetStatistics       &statistics) = 0;
 
+    /**
+     * Free the matrices, vectors and the AMG hierarchy of this mesh once the
+     * active set method has finished on it, so that the postprocessing, the
+     * estimators and the refinement run without them; setup() makes them
+     * anew for the next mesh.
+     */
+    virtual void
+    clear();
+
     /** The method and its linear solver, e.g. "coupled, direct". */
     std::string
     description() const;

@@ -108,6 +108,13 @@ namespace membranes
           const double               tolerance,
           ActiveSetStatistics       &statistics) override;
 
+    /**
+     * Also the scalar DoFHandler, its constraints, A, the matrix of W, S, W,
+     * their right-hand sides and the maps between the DoFs.
+     */
+    void
+    clear() override;
+
   private:
     /**
      * The operator A and the right-hand sides of S and of W (without the

@@ -260,9 +260,6 @@ namespace membranes
     std::vector<std::array<int, 2>>                     local_positions;
     std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
     IndexSet                                            interior_vertex_dofs;
-    std::array<std::vector<double>, 2>                  lambda_i;
-    std::array<std::vector<double>, 2>                  stiffness_terms;
-    std::array<std::vector<double>, 2>                  load_terms;
     double                                              max_force;
     double                                              l2_force;
   };

@@ -90,6 +90,10 @@ namespace membranes
     bool
     has_mesh_preconditioner() const;
 
+    /** Free the AMG hierarchy, when the last solve of a mesh is done. */
+    void
+    clear();
+
     /** "direct" or "cg-amg": what the last reinit() chose. */
     std::string
     method() const;
