@@ -1,5 +1,6 @@
 #include <Epetra_CrsMatrix.h>
 #include <deal.II/dofs/dof_tools.h>
+#include <membranes/cell_loop.h>
 #include <membranes/decoupled_system.h>
 
 namespace membranes
@@ -184,42 +185,63 @@ namespace membranes
   void
   DecoupledSystem<dim>::assemble_operator()
   {
-    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double       M = mu1 + mu2;
-    const unsigned int n =
-      this->discretization.fe->base_element(0).n_dofs_per_cell();
-    FullMatrix<double>                   difference_matrix(n, n);
-    Vector<double>                       sum_loads(n), difference_loads(n);
-    std::vector<types::global_dof_index> scalar_dof_indices(n);
+    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double M = mu1 + mu2;
+    // A_K, the loads of S and of W and the scalar DoFs of a cell, computed
+    // on threads; the copier adds them to the global systems.
+    struct CellContribution
+    {
+      FullMatrix<double>                   laplace_matrix, difference_matrix;
+      Vector<double>                       sum_loads, difference_loads;
+      std::vector<types::global_dof_index> scalar_dof_indices;
+    };
 
     laplace_matrix = 0;
     sum_rhs        = 0;
     difference_rhs = 0;
-    CellSystem<dim> cell_system(this->discretization, this->data);
-    for (const auto &cell : dof_handler->active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          cell_system.reinit_operator(cell);
-          cell_system.set_loads(action->cell_loads(cell));
-          cell_of(scalar_dof_handler, cell)
-            ->get_dof_indices(scalar_dof_indices);
-          sum_loads.equ(1., cell_system.loads[0]);
-          sum_loads.add(1., cell_system.loads[1]);
-          sum_constraints.distribute_local_to_global(cell_system.laplace_matrix,
-                                                     sum_loads,
-                                                     scalar_dof_indices,
-                                                     laplace_matrix,
-                                                     sum_rhs);
-          // The loads of W, with its boundary values lifted by the cell
-          // matrix of its system, μ̄ A_K.
-          difference_matrix.equ(this->data.mu_bar, cell_system.laplace_matrix);
-          difference_loads.equ(mu2 / M, cell_system.loads[0]);
-          difference_loads.add(-mu1 / M, cell_system.loads[1]);
-          difference_constraints.distribute_local_to_global(difference_loads,
-                                                            scalar_dof_indices,
-                                                            difference_rhs,
-                                                            difference_matrix);
-        }
+    run_on_cells<CellContribution>(
+      *dof_handler,
+      [&]() {
+        return std::make_unique<CellSystem<dim>>(this->discretization,
+                                                 this->data);
+      },
+      [&](const auto       &cell,
+          CellSystem<dim>  &cell_system,
+          CellContribution &contribution) {
+        contribution.scalar_dof_indices.clear();
+        if (!cell->is_locally_owned())
+          return;
+        cell_system.reinit_operator(cell);
+        cell_system.set_loads(action->cell_loads(cell));
+        contribution.scalar_dof_indices.resize(cell_system.laplace_matrix.m());
+        cell_of(scalar_dof_handler, cell)
+          ->get_dof_indices(contribution.scalar_dof_indices);
+        contribution.laplace_matrix = cell_system.laplace_matrix;
+        contribution.sum_loads      = cell_system.loads[0];
+        contribution.sum_loads.add(1., cell_system.loads[1]);
+        // The loads of W, with its boundary values lifted by the cell
+        // matrix of its system, μ̄ A_K.
+        contribution.difference_matrix = cell_system.laplace_matrix;
+        contribution.difference_matrix *= this->data.mu_bar;
+        contribution.difference_loads = cell_system.loads[0];
+        contribution.difference_loads *= mu2 / M;
+        contribution.difference_loads.add(-mu1 / M, cell_system.loads[1]);
+      },
+      [&](const CellContribution &contribution) {
+        if (contribution.scalar_dof_indices.empty())
+          return;
+        sum_constraints.distribute_local_to_global(
+          contribution.laplace_matrix,
+          contribution.sum_loads,
+          contribution.scalar_dof_indices,
+          laplace_matrix,
+          sum_rhs);
+        difference_constraints.distribute_local_to_global(
+          contribution.difference_loads,
+          contribution.scalar_dof_indices,
+          difference_rhs,
+          contribution.difference_matrix);
+      });
     laplace_matrix.compress(VectorOperation::add);
     sum_rhs.compress(VectorOperation::add);
     difference_rhs.compress(VectorOperation::add);
