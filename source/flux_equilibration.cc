@@ -523,27 +523,72 @@ namespace membranes
                   }
               }
           }
-    // The entries sorted by vertex (counting sort), and the vertices of
-    // each kind (0: regular vertex, 1: m_e, 2: b_K, 3: hanging vertex):
-    // two of one kind share no sub-triangle.
-    std::vector<unsigned int> start(n_nodes + 1, 0);
-    for (const Entry &entry : entries)
-      ++start[entry.node + 1];
-    for (unsigned int node = 0; node < n_nodes; ++node)
-      start[node + 1] += start[node];
-    std::vector<Entry> sorted(entries.size());
-    {
-      std::vector<unsigned int> next(start.begin(), start.end() - 1);
-      for (const Entry &entry : entries)
-        sorted[next[entry.node]++] = entry;
-    }
+    // The vertices of each kind (0: regular vertex, 1: m_e, 2: b_K, 3:
+    // hanging vertex; two of one kind share no sub-triangle) in the order
+    // in which the cells meet them first, so that a sweep runs through
+    // sub_triangle_data nearly in order, and their entries, vertex by
+    // vertex in the order of the sweeps. The Gram matrices are symmetric,
+    // so u_κ·(G_κ F_κ) = (G_κ u_κ)·F_κ: with G_κ u_κ and u_κ·g_κ of each
+    // entry and Σ_κ u_κ·G_κ u_κ of each vertex computed once, a sweep reads
+    // only the fluxes F_κ.
     std::array<std::vector<unsigned int>, 4> of_kind;
-    for (unsigned int node = 0; node < n_nodes; ++node)
-      if (owned[node] && !on_boundary[node] && start[node + 1] > start[node])
+    std::vector<unsigned int>                count(n_nodes, 0);
+    for (const Entry &entry : entries)
+      if (const unsigned int node = entry.node;
+          owned[node] && !on_boundary[node] && count[node]++ == 0)
         of_kind[node < n_vertices ? (hanging[node] ? 3 : 0) :
                 node < first_cell ? 1 :
                                     2]
           .push_back(node);
+    struct Rotation
+    {
+      unsigned int          kappa;
+      std::array<double, 3> u, Gu;
+      std::array<double, 2> ug;
+    };
+    struct Vertex
+    {
+      unsigned int begin, end;
+      double       denominator;
+    };
+    const std::array<unsigned int, 4>  sweep_order{{2, 1, 0, 3}};
+    std::array<std::vector<Vertex>, 4> vertices_of_kind;
+    std::vector<unsigned int>          next(n_nodes, 0);
+    unsigned int                       n_rotations = 0;
+    for (const unsigned int kind : sweep_order)
+      for (const unsigned int node : of_kind[kind])
+        {
+          next[node] = n_rotations;
+          vertices_of_kind[kind].push_back(
+            {n_rotations, n_rotations + count[node], 0.});
+          n_rotations += count[node];
+        }
+    std::vector<Rotation> rotations(n_rotations);
+    for (const Entry &entry : entries)
+      if (count[entry.node] > 0)
+        {
+          const SubTriangleData &kappa    = sub_triangle_data[entry.kappa];
+          Rotation              &rotation = rotations[next[entry.node]++];
+          rotation.kappa                  = entry.kappa;
+          rotation.u                      = entry.u;
+          for (unsigned int k = 0; k < 3; ++k)
+            {
+              rotation.Gu[k] = 0;
+              for (unsigned int l = 0; l < 3; ++l)
+                rotation.Gu[k] += kappa.gram[k][l] * entry.u[l];
+            }
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              rotation.ug[i] = 0;
+              for (unsigned int k = 0; k < 3; ++k)
+                rotation.ug[i] += entry.u[k] * kappa.discrete_flux[i][k];
+            }
+        }
+    for (auto &vertices : vertices_of_kind)
+      for (Vertex &p : vertices)
+        for (unsigned int t = p.begin; t < p.end; ++t)
+          for (unsigned int k = 0; k < 3; ++k)
+            p.denominator += rotations[t].u[k] * rotations[t].Gu[k];
 
     // σ_ih of the owned cells to the ghost cells of the other processes.
     using Fluxes        = std::array<std::array<double, 3>, 2>;
@@ -570,36 +615,33 @@ namespace membranes
     };
 
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
-      for (const unsigned int kind : {2u, 1u, 0u, 3u})
+      for (const unsigned int kind : sweep_order)
         {
           exchange();
-          for (const unsigned int node : of_kind[kind])
-            for (unsigned int i = 0; i < 2; ++i)
-              {
-                double numerator = 0, denominator = 0;
-                for (unsigned int t = start[node]; t < start[node + 1]; ++t)
-                  {
-                    const SubTriangleData &kappa =
-                      sub_triangle_data[sorted[t].kappa];
-                    const auto &u = sorted[t].u;
+          for (const Vertex &p : vertices_of_kind[kind])
+            {
+              std::array<double, 2> numerator{};
+              for (unsigned int t = p.begin; t < p.end; ++t)
+                {
+                  const Rotation &rotation = rotations[t];
+                  const auto     &F =
+                    sub_triangle_data[rotation.kappa].equilibrated;
+                  for (unsigned int i = 0; i < 2; ++i)
+                    {
+                      numerator[i] += rotation.ug[i];
+                      for (unsigned int k = 0; k < 3; ++k)
+                        numerator[i] += rotation.Gu[k] * F[i][k];
+                    }
+                }
+              for (unsigned int i = 0; i < 2; ++i)
+                {
+                  const double c = -numerator[i] / p.denominator;
+                  for (unsigned int t = p.begin; t < p.end; ++t)
                     for (unsigned int k = 0; k < 3; ++k)
-                      {
-                        double Gu = 0, GF = 0;
-                        for (unsigned int l = 0; l < 3; ++l)
-                          {
-                            Gu += kappa.gram[k][l] * u[l];
-                            GF += kappa.gram[k][l] * kappa.equilibrated[i][l];
-                          }
-                        numerator += u[k] * (GF + kappa.discrete_flux[i][k]);
-                        denominator += u[k] * Gu;
-                      }
-                  }
-                const double c = -numerator / denominator;
-                for (unsigned int t = start[node]; t < start[node + 1]; ++t)
-                  for (unsigned int k = 0; k < 3; ++k)
-                    sub_triangle_data[sorted[t].kappa].equilibrated[i][k] +=
-                      c * sorted[t].u[k];
-              }
+                      sub_triangle_data[rotations[t].kappa]
+                        .equilibrated[i][k] += c * rotations[t].u[k];
+                }
+            }
         }
   }
 
