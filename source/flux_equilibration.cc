@@ -287,38 +287,69 @@ namespace membranes
     // The owned cells of the support of each condensed φ_a, with the
     // coefficients of φ_a in the hat functions of the cell's vertices (1
     // at a, the constraint weight at a hanging vertex with parent a): in
-    // local_patches if this process owns a, else to be sent to a's owner.
+    // local_patches if this process owns a (sorted by a below, the cells
+    // of one a in the order of the cells), else to be sent to a's owner.
     using Coefficients =
       std::array<double, GeometryInfo<dim>::vertices_per_cell>;
-    std::map<types::global_dof_index,
-             std::vector<std::pair<CellIterator, Coefficients>>>
-      local_patches;
+    struct PatchMember
+    {
+      types::global_dof_index a;
+      CellIterator            cell;
+      Coefficients            coefficients;
+    };
+    std::vector<PatchMember> local_patches;
+    local_patches.reserve(dof_handler->get_triangulation().n_active_cells() *
+                          GeometryInfo<dim>::vertices_per_cell);
     std::vector<std::tuple<CellIterator, types::global_dof_index, Coefficients>>
                                          remote;
     std::vector<types::global_dof_index> remote_vertices;
+    // The condensed hat functions of one cell, by increasing a: at most two
+    // parents for each vertex.
+    std::vector<std::pair<types::global_dof_index, Coefficients>> of_cell;
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          std::map<types::global_dof_index, Coefficients> of_cell;
+          of_cell.clear();
+          const auto add = [&](const types::global_dof_index a,
+                               const unsigned int            v,
+                               const double                  weight) {
+            auto entry =
+              std::find_if(of_cell.begin(), of_cell.end(), [a](const auto &e) {
+                return e.first == a;
+              });
+            if (entry == of_cell.end())
+              entry = of_cell.insert(of_cell.end(), {a, Coefficients{}});
+            entry->second[v] += weight;
+          };
           for (const unsigned int v : cell->vertex_indices())
             {
               const auto dof = cell->vertex_dof_index(v, 0);
               if (const auto *entries =
                     hanging_node_constraints.get_constraint_entries(dof))
                 for (const auto &[parent, weight] : *entries)
-                  of_cell[parent][v] += weight;
+                  add(parent, v, weight);
               else
-                of_cell[dof][v] += 1;
+                add(dof, v, 1);
             }
+          std::sort(of_cell.begin(),
+                    of_cell.end(),
+                    [](const auto &p, const auto &q) {
+                      return p.first < q.first;
+                    });
           for (const auto &[a, coefficients] : of_cell)
             if (locally_owned_dofs.is_element(a))
-              local_patches[a].emplace_back(cell, coefficients);
+              local_patches.push_back({a, cell, coefficients});
             else
               {
                 remote.emplace_back(cell, a, coefficients);
                 remote_vertices.push_back(a);
               }
         }
+    std::stable_sort(local_patches.begin(),
+                     local_patches.end(),
+                     [](const PatchMember &p, const PatchMember &q) {
+                       return p.a < q.a;
+                     });
     std::sort(remote_vertices.begin(), remote_vertices.end());
     IndexSet remote_set(locally_owned_dofs.size());
     remote_set.add_indices(remote_vertices.begin(),
@@ -368,16 +399,22 @@ namespace membranes
     std::vector<double>         local_records, local_results;
     std::vector<const double *> patch;
     std::vector<double *>       result;
-    for (const auto &[a, cells] : local_patches)
+    for (auto first = local_patches.begin(); first != local_patches.end();)
       {
-        local_records.resize(cells.size() * record_size);
-        local_results.assign(cells.size() * result_size, 0.);
+        const types::global_dof_index a = first->a;
+        const auto                    last =
+          std::find_if(first, local_patches.end(), [a](const PatchMember &p) {
+            return p.a != a;
+          });
+        const unsigned int n_cells = last - first;
+        local_records.resize(n_cells * record_size);
+        local_results.assign(n_cells * result_size, 0.);
         patch.clear();
         result.clear();
-        for (unsigned int c = 0; c < cells.size(); ++c)
+        for (unsigned int c = 0; c < n_cells; ++c)
           {
-            write_patch_record(cells[c].first,
-                               cells[c].second,
+            write_patch_record(first[c].cell,
+                               first[c].coefficients,
                                patch_terms,
                                local_records.data() + c * record_size);
             patch.push_back(local_records.data() + c * record_size);
@@ -392,9 +429,10 @@ namespace membranes
               result.push_back(replies[process].data() + r * result_size);
             }
         solve_patch_problem(a, patch, result, scratch);
-        for (unsigned int c = 0; c < cells.size(); ++c)
-          add_patch_result(cells[c].first,
+        for (unsigned int c = 0; c < n_cells; ++c)
+          add_patch_result(first[c].cell,
                            local_results.data() + c * result_size);
+        first = last;
       }
     for (const auto &[process, buffer] :
          Utilities::MPI::some_to_some(mpi_communicator, replies))
