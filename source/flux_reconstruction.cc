@@ -4,7 +4,6 @@
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
 #include <membranes/flux_reconstruction.h>
-#include <unordered_map>
 
 // The fluxes t_ih of (4.13) and the identities (4.17), (4.18) and Lemma 17,
 // the evaluation of σ_ih, and the dual mesh as output; the patch
@@ -121,20 +120,6 @@ namespace membranes
       const auto q = edge->vertex_dof_index(1, 0);
       return {{std::min(p, q), std::max(p, q)}};
     }
-
-
-
-    /** A hash of an EdgeKey. */
-    struct EdgeKeyHash
-    {
-      std::size_t
-      operator()(const std::array<types::global_dof_index, 2> &key) const
-      {
-        return std::hash<unsigned long long>()(
-          static_cast<unsigned long long>(key[0]) * 0x9e3779b97f4a7c15ull ^
-          key[1]);
-      }
-    };
 
 
 
@@ -302,11 +287,14 @@ namespace membranes
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
     sub_triangle_data.assign(n_cells * n_triangles, SubTriangleData());
-    std::unordered_map<EdgeKey, unsigned int, EdgeKeyHash> free_flux_index;
-    std::vector<FreeFlux<dim>>                             free_fluxes;
+    // The unknown of a half-edge a–m_e at 2 × the index of its face + the
+    // end a of the face, that of a whole edge at 2 × its index.
+    std::vector<unsigned int> free_flux_index(
+      2 * dof_handler.get_triangulation().n_raw_faces(),
+      numbers::invalid_unsigned_int);
+    std::vector<FreeFlux<dim>>                   free_fluxes;
     std::vector<std::pair<unsigned int, double>> free_flux_of(n_cells *
                                                               n_triangles);
-    free_flux_index.reserve(n_cells * n_triangles);
     free_fluxes.reserve(n_cells * n_triangles);
     load_at_points.assign(2 * n_cells * points.n_volume, 0.);
     std::vector<PatchTerms> patch_terms(n_cells * n_triangles);
@@ -324,18 +312,17 @@ namespace membranes
           for (unsigned int i = 0; i < 2; ++i)
             fe_values[FEValuesExtractors::Scalar(i)].get_function_gradients(
               ghosted_solution, gradients[i]);
-          std::array<std::vector<double>, 2> loads;
+          std::array<const double *, 2> loads;
           for (unsigned int q = 0; q < points.n_volume; ++q)
             volume_points[q] = fe_values.quadrature_point(q);
           for (unsigned int i = 0; i < 2; ++i)
             {
               data.load(i).value_list(volume_points, load);
-              loads[i] = load;
-              std::copy(load.begin(),
-                        load.end(),
-                        load_at_points.begin() +
-                          (2 * cell->active_cell_index() + i) *
-                            points.n_volume);
+              const auto first =
+                load_at_points.begin() +
+                (2 * cell->active_cell_index() + i) * points.n_volume;
+              std::copy(load.begin(), load.end(), first);
+              loads[i] = &*first;
             }
           for (unsigned int s = 0; s < n_triangles; ++s)
             {
@@ -436,12 +423,14 @@ namespace membranes
               const auto         a = cell->vertex_dof_index(triangle.vertex, 0);
               const auto         b = face->vertex_dof_index(
                 face->vertex_dof_index(0, 0) == a ? 1 : 0, 0);
-              EdgeKey key{{a, b}}, patch_key{{a, b}};
-              auto    patch_edge   = face;
-              double  patch_factor = 1;
+              EdgeKey      patch_key{{a, b}};
+              unsigned int slot =
+                2 * face->index() + (face->vertex_dof_index(0, 0) == a ? 0 : 1);
+              auto   patch_edge   = face;
+              double patch_factor = 1;
               if (!cell->at_boundary(f) && face->has_children())
                 {
-                  key                   = edge_key(face);
+                  slot                  = 2 * face->index();
                   const auto first_half = face->child(0);
                   patch_edge = first_half->vertex_dof_index(0, 0) == a ||
                                    first_half->vertex_dof_index(1, 0) == a ?
@@ -451,7 +440,7 @@ namespace membranes
                 }
               else if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
                 {
-                  key          = edge_key(coarse_face(cell, f));
+                  slot         = 2 * coarse_face(cell, f)->index();
                   patch_key    = edge_key(face);
                   patch_factor = 0.5;
                 }
@@ -482,14 +471,15 @@ namespace membranes
               normal /= normal.norm();
               if (normal * (face->center() - cell->center()) < 0)
                 normal *= -1;
-              const auto [entry, is_new] =
-                free_flux_index.emplace(key, free_fluxes.size());
-              if (is_new)
-                free_fluxes.push_back({normal, {}, 0});
-              FreeFlux<dim> &free = free_fluxes[entry->second];
+              if (free_flux_index[slot] == numbers::invalid_unsigned_int)
+                {
+                  free_flux_index[slot] = free_fluxes.size();
+                  free_fluxes.push_back({normal, {}, 0});
+                }
+              FreeFlux<dim> &free = free_fluxes[free_flux_index[slot]];
               const double   factor =
                 (normal * free.normal > 0 ? 1. : -1.) * face->measure() / 2;
-              free_flux_of[id] = {entry->second, factor};
+              free_flux_of[id] = {free_flux_index[slot], factor};
               free.denominator += factor * factor * kappa.gram[2][2];
               for (unsigned int i = 0; i < 2; ++i)
                 free.numerator[i] +=
