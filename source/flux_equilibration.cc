@@ -6,6 +6,7 @@
 #include <deal.II/lac/lapack_full_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <map>
+#include <membranes/cell_loop.h>
 #include <membranes/flux_reconstruction.h>
 #include <tuple>
 
@@ -392,48 +393,69 @@ namespace membranes
             .emplace_back(process, r);
       }
 
-    // The patch problems, σ_ih = Σ_a σ_ih^a on the owned cells.
+    // The patch problems on threads, σ_ih = Σ_a σ_ih^a on the owned cells
+    // added by the copier in the order of the patches. A patch is the run
+    // of members with the same a in local_patches, from one of
+    // patch_starts to the next.
     for (auto &kappa : sub_triangle_data)
       kappa.equilibrated = {};
-    PatchScratch                scratch;
-    std::vector<double>         local_records, local_results;
-    std::vector<const double *> patch;
-    std::vector<double *>       result;
-    for (auto first = local_patches.begin(); first != local_patches.end();)
-      {
-        const types::global_dof_index a = first->a;
-        const auto                    last =
-          std::find_if(first, local_patches.end(), [a](const PatchMember &p) {
-            return p.a != a;
-          });
-        const unsigned int n_cells = last - first;
-        local_records.resize(n_cells * record_size);
-        local_results.assign(n_cells * result_size, 0.);
-        patch.clear();
-        result.clear();
-        for (unsigned int c = 0; c < n_cells; ++c)
+    std::vector<unsigned int> patch_starts;
+    for (unsigned int k = 0; k < local_patches.size(); ++k)
+      if (k == 0 || local_patches[k].a != local_patches[k - 1].a)
+        patch_starts.push_back(k);
+    patch_starts.push_back(local_patches.size());
+    struct PatchWork
+    {
+      PatchScratch                scratch;
+      std::vector<double>         records;
+      std::vector<const double *> patch;
+      std::vector<double *>       result;
+    };
+    struct PatchResult
+    {
+      unsigned int        first = 0, n_cells = 0;
+      std::vector<double> results;
+    };
+    run_in_order<PatchResult>(
+      patch_starts.cbegin(),
+      patch_starts.cend() - 1,
+      []() { return std::make_unique<PatchWork>(); },
+      [&](const std::vector<unsigned int>::const_iterator &start,
+          PatchWork                                       &work,
+          PatchResult                                     &out) {
+        out.first                       = start[0];
+        out.n_cells                     = start[1] - start[0];
+        const types::global_dof_index a = local_patches[out.first].a;
+        work.records.resize(out.n_cells * record_size);
+        out.results.assign(out.n_cells * result_size, 0.);
+        work.patch.clear();
+        work.result.clear();
+        for (unsigned int c = 0; c < out.n_cells; ++c)
           {
-            write_patch_record(first[c].cell,
-                               first[c].coefficients,
+            const PatchMember &member = local_patches[out.first + c];
+            write_patch_record(member.cell,
+                               member.coefficients,
                                patch_terms,
-                               local_records.data() + c * record_size);
-            patch.push_back(local_records.data() + c * record_size);
-            result.push_back(local_results.data() + c * result_size);
+                               work.records.data() + c * record_size);
+            work.patch.push_back(work.records.data() + c * record_size);
+            work.result.push_back(out.results.data() + c * result_size);
           }
         if (const auto members = remote_members.find(a);
             members != remote_members.end())
           for (const auto &[process, r] : members->second)
             {
-              patch.push_back(received.at(process).data() +
-                              r * (1 + record_size) + 1);
-              result.push_back(replies[process].data() + r * result_size);
+              work.patch.push_back(received.at(process).data() +
+                                   r * (1 + record_size) + 1);
+              work.result.push_back(replies.at(process).data() +
+                                    r * result_size);
             }
-        solve_patch_problem(a, patch, result, scratch);
-        for (unsigned int c = 0; c < n_cells; ++c)
-          add_patch_result(first[c].cell,
-                           local_results.data() + c * result_size);
-        first = last;
-      }
+        solve_patch_problem(a, work.patch, work.result, work.scratch);
+      },
+      [&](const PatchResult &out) {
+        for (unsigned int c = 0; c < out.n_cells; ++c)
+          add_patch_result(local_patches[out.first + c].cell,
+                           out.results.data() + c * result_size);
+      });
     for (const auto &[process, buffer] :
          Utilities::MPI::some_to_some(mpi_communicator, replies))
       for (unsigned int r = 0; r < sent[process].size(); ++r)

@@ -3,6 +3,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/fe/fe_values.h>
+#include <membranes/cell_loop.h>
 #include <membranes/flux_reconstruction.h>
 
 // The fluxes t_ih of (4.13) and the identities (4.17), (4.18) and Lemma 17,
@@ -258,15 +259,6 @@ namespace membranes
     const auto               &triangles = dual_cell_quadrature.sub_triangles();
     const unsigned int        n_triangles = triangles.size();
     ReconstructionPoints<dim> points(dual_cell_quadrature, false);
-    FEValues<dim>             fe_values(*discretization.mapping,
-                            fe,
-                            points.quadrature,
-                            update_values | update_gradients |
-                              update_jacobians | update_quadrature_points |
-                              update_JxW_values);
-    std::array<std::vector<Tensor<1, dim>>, 2> gradients;
-    for (auto &gradient : gradients)
-      gradient.resize(points.quadrature.size());
     // The Raviart–Thomas basis of each sub-triangle at its points of the
     // dual quadrature, in reference coordinates.
     std::vector<std::array<Tensor<1, dim>, 3>> reference_basis(points.n_volume);
@@ -280,9 +272,7 @@ namespace membranes
                            unit,
                            points.quadrature.point(q));
         }
-    const unsigned int      n_vertices = fe.reference_cell().n_vertices();
-    std::vector<Point<dim>> volume_points(points.n_volume);
-    std::vector<double>     load(points.n_volume);
+    const unsigned int n_vertices = fe.reference_cell().n_vertices();
 
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
@@ -299,195 +289,256 @@ namespace membranes
     load_at_points.assign(2 * n_cells * points.n_volume, 0.);
     std::vector<PatchTerms> patch_terms(n_cells * n_triangles);
 
+    // What one thread needs on a cell, and what a cell gives the
+    // minimization of t_ih (formed by the copier, in the order of the
+    // cells): for each sub-triangle κ the slot of its unknown, the normal
+    // of its edge e and |e|/2.
+    struct Scratch
+    {
+      Scratch(const Discretization<dim> &discretization,
+              const Quadrature<dim>     &quadrature,
+              const unsigned int         n_volume)
+        : fe_values(*discretization.mapping,
+                    *discretization.fe,
+                    quadrature,
+                    update_values | update_gradients | update_jacobians |
+                      update_quadrature_points | update_JxW_values)
+        , volume_points(n_volume)
+        , load(n_volume)
+      {
+        for (auto &gradient : gradients)
+          gradient.resize(quadrature.size());
+      }
+      FEValues<dim>                              fe_values;
+      std::array<std::vector<Tensor<1, dim>>, 2> gradients;
+      std::vector<Point<dim>>                    volume_points;
+      std::vector<double>                        load;
+    };
+    struct HalfEdge
+    {
+      unsigned int   slot;
+      Tensor<1, dim> normal;
+      double         half_measure;
+    };
+    struct CellHalfEdges
+    {
+      unsigned int          cell = numbers::invalid_unsigned_int;
+      std::vector<HalfEdge> half_edges;
+    };
+
     // The owned and the ghost cells: the cells along every half-edge of an
     // owned cell (along the whole coarse edge at a hanging node) lie in
     // them, so the half-edge rule below gives the owned cells the same t_ih
     // as on one process, without communication. (At the outer rim of the
     // ghost layer, groups are cut short by artificial cells; they belong
     // to no owned cell.) The patch problems need the owned cells only.
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (!cell->is_artificial())
-        {
-          fe_values.reinit(cell);
-          for (unsigned int i = 0; i < 2; ++i)
-            fe_values[FEValuesExtractors::Scalar(i)].get_function_gradients(
-              ghosted_solution, gradients[i]);
-          std::array<const double *, 2> loads;
-          for (unsigned int q = 0; q < points.n_volume; ++q)
-            volume_points[q] = fe_values.quadrature_point(q);
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              data.load(i).value_list(volume_points, load);
-              const auto first =
-                load_at_points.begin() +
-                (2 * cell->active_cell_index() + i) * points.n_volume;
-              std::copy(load.begin(), load.end(), first);
-              loads[i] = &*first;
-            }
-          for (unsigned int s = 0; s < n_triangles; ++s)
-            {
-              const auto        &triangle = triangles[s];
-              const unsigned int id =
-                cell->active_cell_index() * n_triangles + s;
-              SubTriangleData &kappa = sub_triangle_data[id];
-              PatchTerms      &terms = patch_terms[id];
+    // Each cell writes its own entries of sub_triangle_data, patch_terms
+    // and load_at_points.
+    run_on_cells<CellHalfEdges>(
+      dof_handler,
+      [&]() {
+        return std::make_unique<Scratch>(discretization,
+                                         points.quadrature,
+                                         points.n_volume);
+      },
+      [&](const auto &cell, Scratch &scratch, CellHalfEdges &copy) {
+        copy.cell = numbers::invalid_unsigned_int;
+        if (cell->is_artificial())
+          return;
+        FEValues<dim> &fe_values     = scratch.fe_values;
+        auto          &gradients     = scratch.gradients;
+        auto          &volume_points = scratch.volume_points;
+        auto          &load          = scratch.load;
+        copy.cell                    = cell->active_cell_index();
+        copy.half_edges.resize(n_triangles);
+        fe_values.reinit(cell);
+        for (unsigned int i = 0; i < 2; ++i)
+          fe_values[FEValuesExtractors::Scalar(i)].get_function_gradients(
+            ghosted_solution, gradients[i]);
+        std::array<const double *, 2> loads;
+        for (unsigned int q = 0; q < points.n_volume; ++q)
+          volume_points[q] = fe_values.quadrature_point(q);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            data.load(i).value_list(volume_points, load);
+            const auto first =
+              load_at_points.begin() +
+              (2 * cell->active_cell_index() + i) * points.n_volume;
+            std::copy(load.begin(), load.end(), first);
+            loads[i] = &*first;
+          }
+        for (unsigned int s = 0; s < n_triangles; ++s)
+          {
+            const auto        &triangle = triangles[s];
+            const unsigned int id = cell->active_cell_index() * n_triangles + s;
+            SubTriangleData   &kappa = sub_triangle_data[id];
+            PatchTerms        &terms = patch_terms[id];
 
-              // The fluxes (4.13) through the edges 0 and 1, by Gauss points
-              // on the reference edges: n ds = cof(DF) n̂ dŝ. On the owned
-              // cells, the hat function terms of the patch problems (see
-              // equilibrate()): the fluxes of φ_v μ_i ∇u_ih through all
-              // three edges of κ, and ∫ φ_v along a half-edge on ∂ω.
-              const bool owned = cell->is_locally_owned();
-              for (unsigned int e = 0; e < (owned ? 3 : 2); ++e)
-                for (unsigned int k = 0; k < points.n_edge_points; ++k)
-                  {
-                    const unsigned int   q  = points.edge_point(s, e, k);
-                    const Tensor<2, dim> DF = to_tensor(fe_values.jacobian(q));
-                    const Tensor<1, dim> n_ds =
-                      std::abs(determinant(DF)) * transpose(invert(DF)) *
-                      triangle.normals[e] * points.quadrature.weight(q);
-                    std::array<double, 2> flux_density;
+            // The fluxes (4.13) through the edges 0 and 1, by Gauss points
+            // on the reference edges: n ds = cof(DF) n̂ dŝ. On the owned
+            // cells, the hat function terms of the patch problems (see
+            // equilibrate()): the fluxes of φ_v μ_i ∇u_ih through all
+            // three edges of κ, and ∫ φ_v along a half-edge on ∂ω.
+            const bool owned = cell->is_locally_owned();
+            for (unsigned int e = 0; e < (owned ? 3 : 2); ++e)
+              for (unsigned int k = 0; k < points.n_edge_points; ++k)
+                {
+                  const unsigned int   q  = points.edge_point(s, e, k);
+                  const Tensor<2, dim> DF = to_tensor(fe_values.jacobian(q));
+                  const Tensor<1, dim> n_ds =
+                    std::abs(determinant(DF)) * transpose(invert(DF)) *
+                    triangle.normals[e] * points.quadrature.weight(q);
+                  std::array<double, 2> flux_density;
+                  for (unsigned int i = 0; i < 2; ++i)
+                    {
+                      flux_density[i] = data.mu[i] * gradients[i][q] * n_ds;
+                      if (e < 2)
+                        kappa.fluxes[i][e] -= flux_density[i];
+                    }
+                  if (owned)
                     for (unsigned int i = 0; i < 2; ++i)
-                      {
-                        flux_density[i] = data.mu[i] * gradients[i][q] * n_ds;
-                        if (e < 2)
-                          kappa.fluxes[i][e] -= flux_density[i];
-                      }
-                    if (owned)
+                      terms.edge_flux[i][e][k] = flux_density[i];
+                  if (owned && e == 2 && cell->at_boundary(triangle.face))
+                    terms.boundary_length[k] = n_ds.norm();
+                }
+
+            // The Gram matrix of the mapped basis ψ_k, (μ_i ∇u_ih, ψ_k),
+            // the area, ∫ f_i, and the hat function terms on κ.
+            for (unsigned int q = 0; q < points.n_volume; ++q)
+              if (dual_cell_quadrature.sub_triangle_of_point(q) == s)
+                {
+                  const Tensor<2, dim> DF  = to_tensor(fe_values.jacobian(q));
+                  const double         det = std::abs(determinant(DF));
+                  std::array<Tensor<1, dim>, 3> psi;
+                  for (unsigned int k = 0; k < 3; ++k)
+                    psi[k] = DF * reference_basis[q][k] / det;
+                  const double JxW = fe_values.JxW(q);
+                  kappa.area += JxW;
+                  std::array<Tensor<1, dim>, 2> beta;
+                  for (unsigned int l = 0; l < 2; ++l)
+                    beta[l] = DF * rotation_basis[q][l] / det;
+                  for (unsigned int k = 0; k < 3; ++k)
+                    {
+                      for (unsigned int l = 0; l < 3; ++l)
+                        kappa.gram[k][l] += psi[k] * psi[l] * JxW;
+                      for (unsigned int l = 0; l < 2; ++l)
+                        kappa.mixed_gram[k][l] += psi[k] * beta[l] * JxW;
                       for (unsigned int i = 0; i < 2; ++i)
-                        terms.edge_flux[i][e][k] = flux_density[i];
-                    if (owned && e == 2 && cell->at_boundary(triangle.face))
-                      terms.boundary_length[k] = n_ds.norm();
-                  }
-
-              // The Gram matrix of the mapped basis ψ_k, (μ_i ∇u_ih, ψ_k),
-              // the area, ∫ f_i, and the hat function terms on κ.
-              for (unsigned int q = 0; q < points.n_volume; ++q)
-                if (dual_cell_quadrature.sub_triangle_of_point(q) == s)
-                  {
-                    const Tensor<2, dim> DF  = to_tensor(fe_values.jacobian(q));
-                    const double         det = std::abs(determinant(DF));
-                    std::array<Tensor<1, dim>, 3> psi;
-                    for (unsigned int k = 0; k < 3; ++k)
-                      psi[k] = DF * reference_basis[q][k] / det;
-                    const double JxW = fe_values.JxW(q);
-                    kappa.area += JxW;
-                    std::array<Tensor<1, dim>, 2> beta;
-                    for (unsigned int l = 0; l < 2; ++l)
-                      beta[l] = DF * rotation_basis[q][l] / det;
-                    for (unsigned int k = 0; k < 3; ++k)
-                      {
-                        for (unsigned int l = 0; l < 3; ++l)
-                          kappa.gram[k][l] += psi[k] * psi[l] * JxW;
-                        for (unsigned int l = 0; l < 2; ++l)
-                          kappa.mixed_gram[k][l] += psi[k] * beta[l] * JxW;
-                        for (unsigned int i = 0; i < 2; ++i)
-                          kappa.discrete_flux[i][k] +=
-                            data.mu[i] * gradients[i][q] * psi[k] * JxW;
-                      }
-                    for (unsigned int l = 0; l < 2; ++l)
-                      {
-                        for (unsigned int m = 0; m < 2; ++m)
-                          kappa.rotation_gram[l][m] += beta[l] * beta[m] * JxW;
-                        for (unsigned int i = 0; i < 2; ++i)
-                          kappa.discrete_rotation[i][l] +=
-                            data.mu[i] * gradients[i][q] * beta[l] * JxW;
-                      }
-                    for (unsigned int i = 0; i < 2; ++i)
-                      kappa.load[i] += loads[i][q] * JxW;
-                    for (unsigned int v = 0; v < (owned ? n_vertices : 0); ++v)
-                      {
-                        const unsigned int k =
-                          fe.component_to_system_index(0, v);
-                        const double phi = fe_values.shape_value(k, q);
-                        terms.hat_mass[v] += phi * JxW;
-                        for (unsigned int i = 0; i < 2; ++i)
-                          {
-                            terms.hat_residual[i][v] +=
-                              (loads[i][q] * phi -
-                               data.mu[i] * gradients[i][q] *
-                                 fe_values.shape_grad(k, q)) *
-                              JxW;
-                          }
-                      }
-                  }
-
-              // The unknowns of the half-edge a–m_e of κ, by their
-              // EdgeKey: in the minimization of t_ih the half-edge, or at an
-              // edge with a hanging vertex the whole coarse edge; in the
-              // patch problems the half-edge, or at a hanging vertex the
-              // small edge that holds it (with factor 1 from the coarse
-              // side, 1/2 for each of the two half-edges on the fine side).
-              const unsigned int f    = triangle.face;
-              const auto         face = cell->face(f);
-              const auto         a = cell->vertex_dof_index(triangle.vertex, 0);
-              const auto         b = face->vertex_dof_index(
-                face->vertex_dof_index(0, 0) == a ? 1 : 0, 0);
-              EdgeKey      patch_key{{a, b}};
-              unsigned int slot =
-                2 * face->index() + (face->vertex_dof_index(0, 0) == a ? 0 : 1);
-              auto   patch_edge   = face;
-              double patch_factor = 1;
-              if (!cell->at_boundary(f) && face->has_children())
-                {
-                  slot                  = 2 * face->index();
-                  const auto first_half = face->child(0);
-                  patch_edge = first_half->vertex_dof_index(0, 0) == a ||
-                                   first_half->vertex_dof_index(1, 0) == a ?
-                                 first_half :
-                                 face->child(1);
-                  patch_key  = edge_key(patch_edge);
-                }
-              else if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
-                {
-                  slot         = 2 * coarse_face(cell, f)->index();
-                  patch_key    = edge_key(face);
-                  patch_factor = 0.5;
-                }
-              if (owned)
-                {
-                  // The patch unknown counts in the direction of
-                  // cross_product_2d() of its edge run from the end with the
-                  // smaller index, alike on both sides.
-                  const bool increasing = patch_edge->vertex_dof_index(0, 0) <
-                                          patch_edge->vertex_dof_index(1, 0);
-                  const Tensor<1, dim> along =
-                    patch_edge->vertex(increasing ? 1 : 0) -
-                    patch_edge->vertex(increasing ? 0 : 1);
-                  terms.key = patch_key;
-                  terms.factor =
-                    (cross_product_2d(along) *
-                           (patch_edge->center() - cell->center()) >
-                         0 ?
-                       patch_factor :
-                       -patch_factor);
-                  terms.on_boundary = cell->at_boundary(f);
+                        kappa.discrete_flux[i][k] +=
+                          data.mu[i] * gradients[i][q] * psi[k] * JxW;
+                    }
+                  for (unsigned int l = 0; l < 2; ++l)
+                    {
+                      for (unsigned int m = 0; m < 2; ++m)
+                        kappa.rotation_gram[l][m] += beta[l] * beta[m] * JxW;
+                      for (unsigned int i = 0; i < 2; ++i)
+                        kappa.discrete_rotation[i][l] +=
+                          data.mu[i] * gradients[i][q] * beta[l] * JxW;
+                    }
+                  for (unsigned int i = 0; i < 2; ++i)
+                    kappa.load[i] += loads[i][q] * JxW;
+                  for (unsigned int v = 0; v < (owned ? n_vertices : 0); ++v)
+                    {
+                      const unsigned int k = fe.component_to_system_index(0, v);
+                      const double       phi = fe_values.shape_value(k, q);
+                      terms.hat_mass[v] += phi * JxW;
+                      for (unsigned int i = 0; i < 2; ++i)
+                        {
+                          terms.hat_residual[i][v] +=
+                            (loads[i][q] * phi - data.mu[i] * gradients[i][q] *
+                                                   fe_values.shape_grad(k, q)) *
+                            JxW;
+                        }
+                    }
                 }
 
-              // The contribution of κ to the minimization of its unknown s,
-              // (−μ_i ∇u_ih − P_κ, ψ_κ) with ψ_κ = ψ_2.
-              Tensor<1, dim> normal =
-                cross_product_2d(face->vertex(1) - face->vertex(0));
-              normal /= normal.norm();
-              if (normal * (face->center() - cell->center()) < 0)
-                normal *= -1;
-              if (free_flux_index[slot] == numbers::invalid_unsigned_int)
-                {
-                  free_flux_index[slot] = free_fluxes.size();
-                  free_fluxes.push_back({normal, {}, 0});
-                }
-              FreeFlux<dim> &free = free_fluxes[free_flux_index[slot]];
-              const double   factor =
-                (normal * free.normal > 0 ? 1. : -1.) * face->measure() / 2;
-              free_flux_of[id] = {free_flux_index[slot], factor};
-              free.denominator += factor * factor * kappa.gram[2][2];
-              for (unsigned int i = 0; i < 2; ++i)
-                free.numerator[i] +=
-                  factor * (-kappa.discrete_flux[i][2] -
-                            kappa.fluxes[i][0] * kappa.gram[0][2] -
-                            kappa.fluxes[i][1] * kappa.gram[1][2]);
-            }
-        }
+            // The unknowns of the half-edge a–m_e of κ, by their
+            // EdgeKey: in the minimization of t_ih the half-edge, or at an
+            // edge with a hanging vertex the whole coarse edge; in the
+            // patch problems the half-edge, or at a hanging vertex the
+            // small edge that holds it (with factor 1 from the coarse
+            // side, 1/2 for each of the two half-edges on the fine side).
+            const unsigned int f    = triangle.face;
+            const auto         face = cell->face(f);
+            const auto         a = cell->vertex_dof_index(triangle.vertex, 0);
+            const auto         b =
+              face->vertex_dof_index(face->vertex_dof_index(0, 0) == a ? 1 : 0,
+                                     0);
+            EdgeKey      patch_key{{a, b}};
+            unsigned int slot =
+              2 * face->index() + (face->vertex_dof_index(0, 0) == a ? 0 : 1);
+            auto   patch_edge   = face;
+            double patch_factor = 1;
+            if (!cell->at_boundary(f) && face->has_children())
+              {
+                slot                  = 2 * face->index();
+                const auto first_half = face->child(0);
+                patch_edge = first_half->vertex_dof_index(0, 0) == a ||
+                                 first_half->vertex_dof_index(1, 0) == a ?
+                               first_half :
+                               face->child(1);
+                patch_key  = edge_key(patch_edge);
+              }
+            else if (!cell->at_boundary(f) && cell->neighbor_is_coarser(f))
+              {
+                slot         = 2 * coarse_face(cell, f)->index();
+                patch_key    = edge_key(face);
+                patch_factor = 0.5;
+              }
+            if (owned)
+              {
+                // The patch unknown counts in the direction of
+                // cross_product_2d() of its edge run from the end with the
+                // smaller index, alike on both sides.
+                const bool increasing = patch_edge->vertex_dof_index(0, 0) <
+                                        patch_edge->vertex_dof_index(1, 0);
+                const Tensor<1, dim> along =
+                  patch_edge->vertex(increasing ? 1 : 0) -
+                  patch_edge->vertex(increasing ? 0 : 1);
+                terms.key         = patch_key;
+                terms.factor      = (cross_product_2d(along) *
+                                      (patch_edge->center() - cell->center()) >
+                                    0 ?
+                                       patch_factor :
+                                       -patch_factor);
+                terms.on_boundary = cell->at_boundary(f);
+              }
+
+            Tensor<1, dim> normal =
+              cross_product_2d(face->vertex(1) - face->vertex(0));
+            normal /= normal.norm();
+            if (normal * (face->center() - cell->center()) < 0)
+              normal *= -1;
+            copy.half_edges[s] = {slot, normal, face->measure() / 2};
+          }
+      },
+      [&](const CellHalfEdges &copy) {
+        if (copy.cell == numbers::invalid_unsigned_int)
+          return;
+        // The contribution of each κ to the minimization of its unknown,
+        // (−μ_i ∇u_ih − P_κ, ψ_κ) with ψ_κ = ψ_2.
+        for (unsigned int s = 0; s < n_triangles; ++s)
+          {
+            const unsigned int     id    = copy.cell * n_triangles + s;
+            const SubTriangleData &kappa = sub_triangle_data[id];
+            const auto &[slot, normal, half_measure] = copy.half_edges[s];
+            if (free_flux_index[slot] == numbers::invalid_unsigned_int)
+              {
+                free_flux_index[slot] = free_fluxes.size();
+                free_fluxes.push_back({normal, {}, 0});
+              }
+            FreeFlux<dim> &free = free_fluxes[free_flux_index[slot]];
+            const double   factor =
+              (normal * free.normal > 0 ? 1. : -1.) * half_measure;
+            free_flux_of[id] = {free_flux_index[slot], factor};
+            free.denominator += factor * factor * kappa.gram[2][2];
+            for (unsigned int i = 0; i < 2; ++i)
+              free.numerator[i] +=
+                factor * (-kappa.discrete_flux[i][2] -
+                          kappa.fluxes[i][0] * kappa.gram[0][2] -
+                          kappa.fluxes[i][1] * kappa.gram[1][2]);
+          }
+      });
 
     // The minimizers: the fluxes through the half-edges.
     for (const auto &cell : dof_handler.active_cell_iterators())

@@ -49,46 +49,44 @@ namespace membranes
 
 
   /**
-   * Run @p worker(cell, scratch, copy) on every active cell of
-   * @p dof_handler, on the threads of MultithreadInfo (deal.II's WorkStream,
-   * as in step-9), each thread with its own scratch object made by
+   * Run @p worker(item, scratch, copy) on every item of [@p begin, @p end),
+   * on the threads of MultithreadInfo (deal.II's WorkStream, as in
+   * step-9), each thread with its own scratch object made by
    * @p make_scratch, and @p copier(copy) on the results one at a time, in
-   * the order of the cells. Sums formed in the copier are therefore the
-   * same, to the last bit, for any number of threads. The worker decides
-   * which cells it works on (locally owned ones, or all but artificial
-   * ones) and leaves @p copy empty on the others.
+   * the order of the items. Sums formed in the copier are therefore the
+   * same, to the last bit, for any number of threads.
    *
    * An exception thrown by the worker (an expression of the scene that is
    * not finite at a point) would end the program in WorkStream, which
    * aborts on exceptions of its threads: the first one is kept, the
-   * remaining cells are skipped, and it is thrown again here, on the
+   * remaining items are skipped, and it is thrown again here, on the
    * calling thread, as from a loop without threads.
    */
   template <typename Copy,
-            int dim,
+            typename Iterator,
             typename MakeScratch,
             typename Worker,
             typename Copier>
   void
-  run_on_cells(const DoFHandler<dim> &dof_handler,
-               const MakeScratch     &make_scratch,
-               const Worker          &worker,
-               const Copier          &copier)
+  run_in_order(const Iterator    &begin,
+               const Iterator    &end,
+               const MakeScratch &make_scratch,
+               const Worker      &worker,
+               const Copier      &copier)
   {
-    using Scratch  = typename std::invoke_result_t<MakeScratch>::element_type;
-    using Iterator = typename DoFHandler<dim>::active_cell_iterator;
+    using Scratch = typename std::invoke_result_t<MakeScratch>::element_type;
     std::exception_ptr failure;
     std::atomic<bool>  failed(false);
     std::mutex         failure_mutex;
     WorkStream::run(
-      dof_handler.begin_active(),
-      dof_handler.end(),
-      [&](const Iterator &cell, ThreadScratch<Scratch> &scratch, Copy &copy) {
+      begin,
+      end,
+      [&](const Iterator &item, ThreadScratch<Scratch> &scratch, Copy &copy) {
         if (failed)
           return;
         try
           {
-            worker(cell, scratch.get(), copy);
+            worker(item, scratch.get(), copy);
           }
         catch (...)
           {
@@ -106,6 +104,30 @@ namespace membranes
       Copy());
     if (failure)
       std::rethrow_exception(failure);
+  }
+
+
+
+  /**
+   * run_in_order() on the active cells of @p dof_handler. The worker
+   * decides which cells it works on (locally owned ones, or all but
+   * artificial ones) and leaves its copy object empty on the others.
+   */
+  template <typename Copy,
+            int dim,
+            typename MakeScratch,
+            typename Worker,
+            typename Copier>
+  void
+  run_on_cells(const DoFHandler<dim> &dof_handler,
+               const MakeScratch     &make_scratch,
+               const Worker          &worker,
+               const Copier          &copier)
+  {
+    const typename DoFHandler<dim>::active_cell_iterator end =
+      dof_handler.end();
+    run_in_order<Copy>(
+      dof_handler.begin_active(), end, make_scratch, worker, copier);
   }
 } // namespace membranes
 
