@@ -9,18 +9,6 @@
 
 namespace membranes
 {
-  namespace
-  {
-    /**
-     * The loops of the residual estimator run on one thread: on two they
-     * were not faster (case M, Q1, 526 338 DoFs: 0.90 s on one thread,
-     * 0.99 s on two, the same program), and on 8.4·10⁶ DoFs the program
-     * with them on two threads took 29.0 s for the estimator where the one
-     * before the threads took 14.6 s (benchmarks/mpi_scaling.sh).
-     */
-    constexpr bool estimator_on_threads = false;
-  } // namespace
-
   template <int dim>
   ErrorEstimator<dim>::ErrorEstimator(const Discretization<dim> &discretization,
                                       const ProblemData<dim>    &data)
@@ -135,8 +123,7 @@ namespace membranes
         indicators[cell->active_cell_index()] +=
           eta2 + 2 * std::max(contact, 0.);
       },
-      [](const NoCopy &) {},
-      estimator_on_threads);
+      [](const NoCopy &) {});
   }
 
 
@@ -319,8 +306,7 @@ namespace membranes
             indicators[cell] += term;
             indicators[neighbor] += term;
           }
-      },
-      estimator_on_threads);
+      });
   }
 
 

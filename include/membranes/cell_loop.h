@@ -61,9 +61,6 @@ namespace membranes
    * aborts on exceptions of its threads: the first one is kept, the
    * remaining items are skipped, and it is thrown again here, on the
    * calling thread, as from a loop without threads.
-   *
-   * With @p on_threads false the same loop runs on the calling thread
-   * only, for loops that threads do not make faster.
    */
   template <typename Copy,
             typename Iterator,
@@ -75,21 +72,9 @@ namespace membranes
                const Iterator    &end,
                const MakeScratch &make_scratch,
                const Worker      &worker,
-               const Copier      &copier,
-               const bool         on_threads = true)
+               const Copier      &copier)
   {
     using Scratch = typename std::invoke_result_t<MakeScratch>::element_type;
-    if (!on_threads)
-      {
-        const auto scratch = make_scratch();
-        Copy       copy;
-        for (Iterator item = begin; item != end; ++item)
-          {
-            worker(item, *scratch, copy);
-            copier(copy);
-          }
-        return;
-      }
     std::exception_ptr failure;
     std::atomic<bool>  failed(false);
     std::mutex         failure_mutex;
@@ -137,17 +122,12 @@ namespace membranes
   run_on_cells(const DoFHandler<dim> &dof_handler,
                const MakeScratch     &make_scratch,
                const Worker          &worker,
-               const Copier          &copier,
-               const bool             on_threads = true)
+               const Copier          &copier)
   {
     const typename DoFHandler<dim>::active_cell_iterator end =
       dof_handler.end();
-    run_in_order<Copy>(dof_handler.begin_active(),
-                       end,
-                       make_scratch,
-                       worker,
-                       copier,
-                       on_threads);
+    run_in_order<Copy>(
+      dof_handler.begin_active(), end, make_scratch, worker, copier);
   }
 } // namespace membranes
 
