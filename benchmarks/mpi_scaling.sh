@@ -10,6 +10,10 @@
 # 2·(2^(k+2)+1)² DoFs on cycle k, 8 396 802 on the last, first on one
 # process, then on two (mpiexec -n 2), CG-AMG, no field output. The same
 # binary and the same scene, one after the other in one run of this script.
+# Neither run is bound to cores (--bind-to none): by default Open MPI binds
+# a process to one core when it starts one or two, and membranes then takes
+# one thread; unbound, the single process uses every core with its threads,
+# the two processes one each.
 #
 # The table of benchmarks/mpi_scaling_table.py is printed at the end and kept
 # in <output-dir>/table.md: per phase of the last cycle the wall time on one
@@ -35,7 +39,7 @@ mkdir -p "$out"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 for processes in 1 2; do
-  command=(mpiexec -n "$processes" "$membranes"
+  command=(mpiexec -n "$processes" --bind-to none "$membranes"
            --set "Refinement/Cycles=$cycles"
            --set "Solver/Linear solver=cg-amg"
            --set "Output/Write vtu=false"

@@ -3,6 +3,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/mapping_cartesian.h>
 #include <deal.II/fe/mapping_fe.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
@@ -180,6 +181,38 @@ namespace membranes
     , mapping(make_mapping<dim>(cell_type))
     , cell_quadrature(make_cell_quadrature<dim>(cell_type))
   {}
+
+
+
+  template <int dim>
+  void
+  Discretization<dim>::select_mapping(const Triangulation<dim> &triangulation)
+  {
+    if (cell_type == Parameters::CellType::triangle)
+      return;
+    // A cell is a rectangle with axis-parallel edges when coordinate d of
+    // each vertex v is that of vertex 0 or of vertex 2^d, as bit d of v
+    // says (in 2D: vertices 0 and 1 share y, 0 and 2 share x, 3 has the x
+    // of 1 and the y of 2). The comparisons are exact: deal.II's generators
+    // and the slit's quarter turn make such meshes exactly. Refinement
+    // keeps the property: it halves the edges.
+    const auto is_rectangle = [](const auto &cell) {
+      if (cell->manifold_id() != numbers::flat_manifold_id)
+        return false;
+      for (const unsigned int v : cell->vertex_indices())
+        for (unsigned int d = 0; d < dim; ++d)
+          if (cell->vertex(v)[d] != cell->vertex(v & (1u << d))[d])
+            return false;
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->manifold_id() != numbers::flat_manifold_id)
+          return false;
+      return true;
+    };
+    for (const auto &cell : triangulation.cell_iterators_on_level(0))
+      if (!is_rectangle(cell))
+        return;
+    mapping = std::make_unique<MappingCartesian<dim>>();
+  }
 
 
 

@@ -13,12 +13,14 @@
 
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/multithread_info.h>
 #include <deal.II/base/parameter_handler.h>
 #include <deal.II/base/utilities.h>
 #include <filesystem>
 #include <iostream>
 #include <membranes/membrane_problem.h>
 #include <membranes/parameters.h>
+#include <sched.h>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,16 @@ namespace
     "(quadrilateral meshes; triangle meshes run on one process).\n"
     "\n"
     "Exit status: 0 on success, 1 with a one-line message on any error.\n";
+
+  /** The number of CPUs in the affinity mask of this process. */
+  unsigned int
+  cpus_of_this_process()
+  {
+    cpu_set_t cpus;
+    if (sched_getaffinity(0, sizeof(cpus), &cpus) != 0)
+      return MultithreadInfo::n_cores();
+    return std::max(CPU_COUNT(&cpus), 1);
+  }
 } // namespace
 
 
@@ -61,8 +73,12 @@ main(int argc, char **argv)
   // The loops over cells outside the linear solver (data, errors,
   // estimators) run on threads: as many per process as there are cores
   // per process on the node (deal.II's default; DEAL_II_NUM_THREADS limits
-  // it).
+  // it), but no more than the CPUs this process may run on. Open MPI binds
+  // each process to one core when it starts one or two of them, and two
+  // threads on one core are slower than one.
   Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv);
+  MultithreadInfo::set_thread_limit(
+    std::min(MultithreadInfo::n_threads(), cpus_of_this_process()));
   const unsigned int process = Utilities::MPI::this_mpi_process(MPI_COMM_WORLD);
   const bool         first_process = (process == 0);
   const unsigned int n_processes =

@@ -45,6 +45,7 @@ namespace membranes
   {
     check_output_directory();
     create_mesh(parameters.geometry, *triangulation);
+    discretization.select_mapping(*triangulation);
     data.check_boundary_data(*triangulation);
     data.check_exact_solution(*triangulation,
                               *discretization.mapping,

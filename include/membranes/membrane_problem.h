@@ -103,8 +103,9 @@ namespace membranes
      */
     TimerOutput computing_timer;
 
-    const ProblemData<dim>    data;
-    const Discretization<dim> discretization;
+    const ProblemData<dim> data;
+    /** Its mapping is chosen on the coarse mesh, in make_grid(). */
+    Discretization<dim> discretization;
 
     const std::unique_ptr<Triangulation<dim>> triangulation;
     DoFHandler<dim>                           dof_handler;
