@@ -31,12 +31,12 @@ namespace membranes
    * solved by the primal-dual active set method on a sequence of meshes,
    * with the action λ_h by the local postprocessing (4.5).
    *
-   * run() is the whole story: for each cycle, set up DoFs and constraints,
-   * transfer the previous solution and active set to the new mesh (nested
-   * iteration), solve, postprocess (λ_h, the discrete identities, errors),
-   * reconstruct the fluxes t_ih (if the scene asks for them), estimate the
-   * error, add a row to the report, write fields, refine (globally, or by
-   * the estimator's indicators).
+   * run() is the whole story: for each cycle, refine the last mesh
+   * (globally, or by the estimator's indicators), set up DoFs and
+   * constraints, transfer the previous solution and active set to the new
+   * mesh (nested iteration), solve, postprocess (λ_h, the discrete
+   * identities, errors), reconstruct the fluxes t_ih (if the scene asks for
+   * them), estimate the error, add a row to the report, write fields.
    *
    * Data layout is that of deal.II's step-40: a distributed triangulation
    * (make_triangulation(): p4est for quadrilaterals, serial for triangles),
