@@ -211,7 +211,8 @@ namespace membranes
     for (const auto &cell : triangulation.cell_iterators_on_level(0))
       if (!is_rectangle(cell))
         return;
-    mapping = std::make_unique<MappingCartesian<dim>>();
+    mapping    = std::make_unique<MappingCartesian<dim>>();
+    rectangles = true;
   }
 
 

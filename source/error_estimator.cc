@@ -49,9 +49,11 @@ namespace membranes
                                       Vector<double> &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
-    // λ_h and u_h on the pieces K ∩ D_a; P1 functions have no second
-    // derivatives, Q1 ones do on non-affine cells.
-    const bool with_laplacians = !fe.reference_cell().is_simplex();
+    // λ_h and u_h on the pieces K ∩ D_a. The Laplacian of u_ih vanishes on
+    // triangles (P1) and on axis-parallel rectangles (Q1: a bilinear
+    // function has no ∂²/∂x², ∂²/∂y²), not on other quadrilaterals.
+    const bool with_laplacians =
+      !fe.reference_cell().is_simplex() && !discretization.rectangles;
     struct Scratch
     {
       Scratch(const Discretization<dim> &discretization,
