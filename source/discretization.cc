@@ -211,8 +211,17 @@ namespace membranes
     for (const auto &cell : triangulation.cell_iterators_on_level(0))
       if (!is_rectangle(cell))
         return;
-    mapping    = std::make_unique<MappingCartesian<dim>>();
-    rectangles = true;
+    mapping = std::make_unique<MappingCartesian<dim>>();
+  }
+
+
+
+  template <int dim>
+  bool
+  Discretization<dim>::rectangles() const
+  {
+    return dynamic_cast<const MappingCartesian<dim> *>(mapping.get()) !=
+           nullptr;
   }
 
 

@@ -53,7 +53,7 @@ namespace membranes
     // triangles (P1) and on axis-parallel rectangles (Q1: a bilinear
     // function has no ∂²/∂x², ∂²/∂y²), not on other quadrilaterals.
     const bool with_laplacians =
-      !fe.reference_cell().is_simplex() && !discretization.rectangles;
+      !fe.reference_cell().is_simplex() && !discretization.rectangles();
     struct Scratch
     {
       Scratch(const Discretization<dim> &discretization,

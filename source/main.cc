@@ -11,6 +11,7 @@
  *   membranes --print-parameters
  */
 
+#include <algorithm>
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/multithread_info.h>

@@ -52,9 +52,13 @@ namespace membranes
     const Parameters::CellType           cell_type;
     const std::unique_ptr<FESystem<dim>> fe;
     std::unique_ptr<Mapping<dim>>        mapping;
-    /** Whether select_mapping() found a mesh of axis-parallel rectangles,
-     * on which a Q1 function has ∂²/∂x² = ∂²/∂y² = 0. */
-    bool rectangles = false;
+
+    /** Whether select_mapping() found a mesh of axis-parallel rectangles
+     * (and took MappingCartesian), on which a Q1 function has
+     * ∂²/∂x² = ∂²/∂y² = 0. */
+    bool
+    rectangles() const;
+
     /** Quadrature for the stiffness matrix and the loads (exact for P1/Q1
      * stiffness, degree 3 for smooth loads). */
     const Quadrature<dim> cell_quadrature;
