@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/parallel.h>
 #include <deal.II/distributed/tria_base.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/lac/full_matrix.h>
@@ -213,10 +214,10 @@ namespace membranes
   template <int dim>
   void
   FluxReconstruction<dim>::write_patch_record(
-    const CellIterator            &cell,
-    const std::array<double, 4>   &coefficients,
-    const std::vector<PatchTerms> &patch_terms,
-    double                        *record) const
+    const CellIterator              &cell,
+    const std::array<double, 4>     &coefficients,
+    const AlignedVector<PatchTerms> &patch_terms,
+    double                          *record) const
   {
     using namespace PatchRecord;
     const unsigned int n_triangles =
@@ -276,7 +277,7 @@ namespace membranes
   template <int dim>
   void
   FluxReconstruction<dim>::equilibrate(
-    const std::vector<PatchTerms>   &patch_terms,
+    const AlignedVector<PatchTerms> &patch_terms,
     const AffineConstraints<double> &hanging_node_constraints,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator)
@@ -627,28 +628,47 @@ namespace membranes
     for (const Entry &entry : entries)
       if (count[entry.node] > 0)
         {
-          const SubTriangleData &kappa    = sub_triangle_data[entry.kappa];
-          Rotation              &rotation = rotations[next[entry.node]++];
-          rotation.kappa                  = entry.kappa;
-          rotation.u                      = entry.u;
-          for (unsigned int k = 0; k < 3; ++k)
-            {
-              rotation.Gu[k] = 0;
-              for (unsigned int l = 0; l < 3; ++l)
-                rotation.Gu[k] += kappa.gram[k][l] * entry.u[l];
-            }
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              rotation.ug[i] = 0;
-              for (unsigned int k = 0; k < 3; ++k)
-                rotation.ug[i] += entry.u[k] * kappa.discrete_flux[i][k];
-            }
+          Rotation &rotation = rotations[next[entry.node]++];
+          rotation.kappa     = entry.kappa;
+          rotation.u         = entry.u;
         }
-    for (auto &vertices : vertices_of_kind)
-      for (Vertex &p : vertices)
+    // The vertices of one kind share no sub-triangle: each loop over them
+    // below runs on threads, on disjoint entries of rotations and sigma,
+    // with the same result as in order.
+    const auto for_vertices_of_kind = [&](const unsigned int kind,
+                                          const auto        &f) {
+      std::vector<Vertex> &vertices = vertices_of_kind[kind];
+      parallel::apply_to_subranges(
+        vertices.begin(),
+        vertices.end(),
+        [&](const auto begin, const auto end) {
+          for (auto p = begin; p != end; ++p)
+            f(*p);
+        },
+        1000);
+    };
+    for (const unsigned int kind : sweep_order)
+      for_vertices_of_kind(kind, [&](Vertex &p) {
         for (unsigned int t = p.begin; t < p.end; ++t)
-          for (unsigned int k = 0; k < 3; ++k)
-            p.denominator += rotations[t].u[k] * rotations[t].Gu[k];
+          {
+            Rotation              &rotation = rotations[t];
+            const SubTriangleData &kappa    = sub_triangle_data[rotation.kappa];
+            for (unsigned int k = 0; k < 3; ++k)
+              {
+                rotation.Gu[k] = 0;
+                for (unsigned int l = 0; l < 3; ++l)
+                  rotation.Gu[k] += kappa.gram[k][l] * rotation.u[l];
+              }
+            for (unsigned int i = 0; i < 2; ++i)
+              {
+                rotation.ug[i] = 0;
+                for (unsigned int k = 0; k < 3; ++k)
+                  rotation.ug[i] += rotation.u[k] * kappa.discrete_flux[i][k];
+              }
+            for (unsigned int k = 0; k < 3; ++k)
+              p.denominator += rotation.u[k] * rotation.Gu[k];
+          }
+      });
 
     // The sweeps work on a copy of the fluxes of σ_ih alone (48 bytes per
     // sub-triangle, in the order of sub_triangle_data), which the caches
@@ -682,28 +702,27 @@ namespace membranes
       for (const unsigned int kind : sweep_order)
         {
           exchange();
-          for (const Vertex &p : vertices_of_kind[kind])
-            {
-              std::array<double, 2> numerator{};
-              for (unsigned int t = p.begin; t < p.end; ++t)
-                {
-                  const Rotation &rotation = rotations[t];
-                  const Fluxes   &F        = sigma[rotation.kappa];
-                  for (unsigned int i = 0; i < 2; ++i)
-                    {
-                      numerator[i] += rotation.ug[i];
-                      for (unsigned int k = 0; k < 3; ++k)
-                        numerator[i] += rotation.Gu[k] * F[i][k];
-                    }
-                }
-              for (unsigned int i = 0; i < 2; ++i)
-                {
-                  const double c = -numerator[i] / p.denominator;
-                  for (unsigned int t = p.begin; t < p.end; ++t)
+          for_vertices_of_kind(kind, [&](const Vertex &p) {
+            std::array<double, 2> numerator{};
+            for (unsigned int t = p.begin; t < p.end; ++t)
+              {
+                const Rotation &rotation = rotations[t];
+                const Fluxes   &F        = sigma[rotation.kappa];
+                for (unsigned int i = 0; i < 2; ++i)
+                  {
+                    numerator[i] += rotation.ug[i];
                     for (unsigned int k = 0; k < 3; ++k)
-                      sigma[rotations[t].kappa][i][k] += c * rotations[t].u[k];
-                }
-            }
+                      numerator[i] += rotation.Gu[k] * F[i][k];
+                  }
+              }
+            for (unsigned int i = 0; i < 2; ++i)
+              {
+                const double c = -numerator[i] / p.denominator;
+                for (unsigned int t = p.begin; t < p.end; ++t)
+                  for (unsigned int k = 0; k < 3; ++k)
+                    sigma[rotations[t].kappa][i][k] += c * rotations[t].u[k];
+              }
+          });
         }
     for (unsigned int id = 0; id < sigma.size(); ++id)
       sub_triangle_data[id].equilibrated = sigma[id];
@@ -1109,7 +1128,7 @@ namespace membranes
 
 
   template void
-  FluxReconstruction<2>::equilibrate(const std::vector<PatchTerms> &,
+  FluxReconstruction<2>::equilibrate(const AlignedVector<PatchTerms> &,
                                      const AffineConstraints<double> &,
                                      const IndexSet &,
                                      const MPI_Comm);

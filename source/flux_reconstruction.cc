@@ -5,6 +5,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <membranes/cell_loop.h>
 #include <membranes/flux_reconstruction.h>
+#include <type_traits>
 
 // The fluxes t_ih of (4.13) and the identities (4.17), (4.18) and Lemma 17,
 // the evaluation of σ_ih, and the dual mesh as output; the patch
@@ -276,7 +277,12 @@ namespace membranes
 
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
-    sub_triangle_data.assign(n_cells * n_triangles, SubTriangleData());
+    // Allocated without initial values: each cell's entries are set to
+    // zero in the cell loop below (see SubTriangleData).
+    static_assert(std::is_trivial_v<SubTriangleData> &&
+                  std::is_trivial_v<PatchTerms>);
+    sub_triangle_data.clear();
+    sub_triangle_data.resize_fast(n_cells * n_triangles);
     // The unknown of a half-edge a–m_e at 2 × the index of its face + the
     // end a of the face, that of a whole edge at 2 × its index.
     std::vector<unsigned int> free_flux_index(
@@ -286,8 +292,10 @@ namespace membranes
     std::vector<std::pair<unsigned int, double>> free_flux_of(n_cells *
                                                               n_triangles);
     free_fluxes.reserve(n_cells * n_triangles);
-    load_at_points.assign(2 * n_cells * points.n_volume, 0.);
-    std::vector<PatchTerms> patch_terms(n_cells * n_triangles);
+    load_at_points.clear();
+    load_at_points.resize_fast(2 * n_cells * points.n_volume);
+    AlignedVector<PatchTerms> patch_terms;
+    patch_terms.resize_fast(n_cells * n_triangles);
 
     // What one thread needs on a cell, and what a cell gives the
     // minimization of t_ih (formed by the copier, in the order of the
@@ -342,7 +350,14 @@ namespace membranes
                                          points.n_volume);
       },
       [&](const auto &cell, Scratch &scratch, CellHalfEdges &copy) {
-        copy.cell = numbers::invalid_unsigned_int;
+        copy.cell                = numbers::invalid_unsigned_int;
+        const unsigned int first = cell->active_cell_index() * n_triangles;
+        std::fill_n(&sub_triangle_data[first], n_triangles, SubTriangleData{});
+        std::fill_n(&patch_terms[first], n_triangles, PatchTerms{});
+        std::fill_n(
+          &load_at_points[2 * cell->active_cell_index() * points.n_volume],
+          2 * points.n_volume,
+          0.);
         if (cell->is_artificial())
           return;
         FEValues<dim> &fe_values     = scratch.fe_values;
