@@ -296,6 +296,7 @@ namespace membranes
     load_at_points.resize_fast(2 * n_cells * points.n_volume);
     AlignedVector<PatchTerms> patch_terms;
     patch_terms.resize_fast(n_cells * n_triangles);
+    hat_integrals.assign(n_cells, {});
 
     // What one thread needs on a cell, and what a cell gives the
     // minimization of t_ih (formed by the copier, in the order of the
@@ -526,6 +527,11 @@ namespace membranes
               normal *= -1;
             copy.half_edges[s] = {slot, normal, face->measure() / 2};
           }
+        if (cell->is_locally_owned())
+          for (unsigned int s = 0; s < n_triangles; ++s)
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              hat_integrals[cell->active_cell_index()][v] +=
+                patch_terms[first + s].hat_mass[v];
       },
       [&](const CellHalfEdges &copy) {
         if (copy.cell == numbers::invalid_unsigned_int)
@@ -572,6 +578,20 @@ namespace membranes
                 hanging_node_constraints,
                 locally_owned_dofs,
                 mpi_communicator);
+  }
+
+
+
+  template <int dim>
+  typename FluxReconstruction<dim>::Identities
+  FluxReconstruction<dim>::identities(
+    const AffineConstraints<double> &hanging_node_constraints,
+    const IndexSet                  &locally_owned_dofs,
+    const MPI_Comm                   mpi_communicator) const
+  {
+    const FiniteElement<dim> &fe        = dof_handler->get_fe();
+    const auto               &triangles = dual_cell_quadrature.sub_triangles();
+    const unsigned int        n_triangles = triangles.size();
 
     // The identities: per cell and vertex v the measure of K ∩ D_v, the
     // integral of div t_ih over it, f_ih meas(K ∩ D_v) and f_ih ∫_K φ_v,
@@ -585,7 +605,7 @@ namespace membranes
       local_divergence(dofs_per_cell), local_load_on_pieces(dofs_per_cell),
       local_load_on_hats(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
-    for (const auto &cell : dof_handler.active_cell_iterators())
+    for (const auto &cell : dof_handler->active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell->get_dof_indices(dof_indices);
@@ -618,13 +638,10 @@ namespace membranes
                 const auto k = fe.component_to_system_index(i, v);
                 local_load_on_pieces(k) =
                   load_mean[i] / area * local_measure(k);
-                // f_ih ∫_K φ_v, with ∫_K φ_v from the patch terms.
-                double hat_integral = 0;
-                for (unsigned int s = 0; s < n_triangles; ++s)
-                  hat_integral +=
-                    patch_terms[cell->active_cell_index() * n_triangles + s]
-                      .hat_mass[v];
-                local_load_on_hats(k) = load_mean[i] / area * hat_integral;
+                // f_ih ∫_K φ_v.
+                local_load_on_hats(k) =
+                  load_mean[i] / area *
+                  hat_integrals[cell->active_cell_index()][v];
               }
           hanging_node_constraints.distribute_local_to_global(local_measure,
                                                               dof_indices,
@@ -640,7 +657,7 @@ namespace membranes
     for (auto *vector : {&measure, &divergence, &load_on_pieces, &load_on_hats})
       vector->compress(VectorOperation::add);
 
-    defects              = Identities();
+    Identities  defects;
     const auto &vertices = action.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
@@ -677,14 +694,6 @@ namespace membranes
     defects.balance_defect =
       Utilities::MPI::max(defects.balance_defect, mpi_communicator) /
       force_scale;
-  }
-
-
-
-  template <int dim>
-  const typename FluxReconstruction<dim>::Identities &
-  FluxReconstruction<dim>::identities() const
-  {
     return defects;
   }
 

@@ -384,7 +384,10 @@ namespace membranes
                                     mpi_communicator);
     if (!parameters.output.flux_reconstruction)
       return;
-    const auto &identities     = flux_reconstruction.identities();
+    const auto identities =
+      flux_reconstruction.identities(hanging_node_constraints,
+                                     locally_owned_dofs,
+                                     mpi_communicator);
     record.measure_defect      = identities.measure_defect;
     record.conservation_defect = identities.conservation_defect;
     record.balance_defect      = identities.balance_defect;

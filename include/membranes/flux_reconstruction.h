@@ -204,9 +204,8 @@ namespace membranes
                        const DiscreteAction<dim> &action);
 
     /**
-     * Compute t_1h, t_2h for @p ghosted_solution on the locally owned cells
-     * of @p dof_handler, and the defects of the identities against the λ_a
-     * of the action.
+     * Compute t_1h, t_2h and σ_1h, σ_2h for @p ghosted_solution on the
+     * locally owned cells of @p dof_handler.
      */
     void
     reconstruct(const DoFHandler<dim>           &dof_handler,
@@ -215,9 +214,15 @@ namespace membranes
                 const IndexSet                  &locally_owned_dofs,
                 const MPI_Comm                   mpi_communicator);
 
-    /** The defects measured by the last reconstruct(). */
-    const Identities &
-    identities() const;
+    /**
+     * The defects of the identities for the t_ih of the last reconstruct(),
+     * against the λ_a of the action. Only the output asks for them: the
+     * flux estimator does not need them.
+     */
+    Identities
+    identities(const AffineConstraints<double> &hanging_node_constraints,
+               const IndexSet                  &locally_owned_dofs,
+               const MPI_Comm                   mpi_communicator) const;
 
     /**
      * σ_ih and div σ_ih of membrane @p i at the points of
@@ -426,7 +431,8 @@ namespace membranes
     std::vector<std::array<Tensor<1, dim>, 2>> rotation_basis;
     /** f_1, f_2 at the points of the dual quadrature, cell by cell. */
     AlignedVector<double> load_at_points;
-    Identities            defects;
+    /** ∫_K φ_v for the vertices v of each locally owned cell K. */
+    std::vector<std::array<double, 4>> hat_integrals;
   };
 } // namespace membranes
 
