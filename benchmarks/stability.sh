@@ -49,10 +49,12 @@ for ratio in 1e-8 1e-4 1 1e4 1e8; do
   run "mu1:mu2=$ratio" "$stability/case-m.prm" --set "Problem/mu1=$ratio" \
     --set "Problem/mu2=1" --set "Refinement/Cycles=$m"
 done
+# At the sizes of refinement studies, with CG-AMG from the first cycle:
+# case M on Q1 to 2.1 million DoFs.
 for ratio in 1e-8 1e8; do
   run "mu1:mu2=$ratio,cg-amg" "$stability/case-m.prm" \
     --set "Problem/mu1=$ratio" --set "Problem/mu2=1" \
-    --set "Refinement/Cycles=$m" --set "Solver/Linear solver=cg-amg"
+    --set "Refinement/Cycles=$(cycles 9 5)" --set "Solver/Linear solver=cg-amg"
 done
 run "unscaled" "$stability/case-m.prm" --set "Refinement/Cycles=$m"
 for scale in 1e-8 1e8; do
@@ -74,6 +76,30 @@ run "graded" "$stability/graded.prm" --set "Refinement/Cycles=$(cycles 24 12)"
 run "degenerate" "$stability/degenerate.prm" --set "Refinement/Cycles=$m"
 run "degenerate*1e8" "$stability/degenerate.prm" \
   --set "Problem/Function constants=S=1e8" --set "Refinement/Cycles=$m"
+# The degenerate straight free boundary (no strict complementarity), the
+# hard class for the active set method, with CG-AMG from the first cycle:
+# P1 to 526 338 DoFs at every tension ratio and data scale, Q1 to 2.1
+# million DoFs, and the coupled method at the extreme ratios.
+straight=$stability/degenerate-straight.prm
+amg=(--set "Solver/Linear solver=cg-amg")
+p1=(--set "Geometry/Cell type=triangle" --set "Refinement/Cycles=$(cycles 7 5)")
+q1=(--set "Geometry/Cell type=quadrilateral" --set "Refinement/Cycles=$(cycles 9 6)")
+for ratio in 1e-8 1e-4 1 1e4 1e8; do
+  run "straight P1 mu1:mu2=$ratio" "$straight" "${amg[@]}" "${p1[@]}" \
+    --set "Problem/mu1=$ratio"
+done
+for scale in 1e-8 1e8; do
+  run "straight P1 data*$scale" "$straight" "${amg[@]}" "${p1[@]}" \
+    --set "Problem/Function constants=x0=0.333333333333333333, L=8, S=$scale"
+done
+for ratio in 1e-8 1 1e8; do
+  run "straight Q1 mu1:mu2=$ratio" "$straight" "${amg[@]}" "${q1[@]}" \
+    --set "Problem/mu1=$ratio"
+done
+for ratio in 1e-8 1e8; do
+  run "straight P1 coupled mu1:mu2=$ratio" "$straight" "${amg[@]}" "${p1[@]}" \
+    --set "Problem/mu1=$ratio" --set "Solver/Method=coupled"
+done
 echo
 
 python3 "$root/benchmarks/stability_table.py" "$out" | tee "$out/table.md"

@@ -19,8 +19,14 @@ Then one PASS/FAIL line per target:
 * every case converges to a relative KKT residual <= 1e-10 on every cycle;
 * every scaled case (a name with ``*``: data or tensions multiplied by a
   factor) has the same DoFs, active set iterations and active vertices on
-  every cycle as its unscaled case (``unscaled`` for case M, the part of the
-  name before ``*`` otherwise).
+  every cycle as its unscaled case (``unscaled`` for case M, the tension
+  ratio 1 case for ``... data*F``, the part of the name before ``*``
+  otherwise);
+* every case needs at most 4 active set iterations on each cycle after the
+  first;
+* every case with a tension ratio (``mu1:mu2=R`` in the name) needs at most
+  one active set iteration more than the case of ratio 1 of the same scene
+  and cell type on each cycle they share.
 
 Exit status 1 if a line says FAIL.
 """
@@ -30,6 +36,7 @@ import os
 import sys
 
 TOLERANCE = 1e-10
+MAX_ITERATIONS_AFTER_FIRST = 4
 
 
 def read_report(path):
@@ -58,7 +65,19 @@ def column(rows, name):
 def unscaled_case(name):
     """The case a scaled case is compared with."""
     base = name.split("*")[0]
-    return "unscaled" if base in ("loads,g", "mu1,mu2") else base
+    if base in ("loads,g", "mu1,mu2"):
+        return "unscaled"
+    if base.endswith(" data"):
+        return base[:-len(" data")] + " mu1:mu2=1"
+    return base
+
+
+def ratio_one_case(name):
+    """The tension ratio 1 case of a case with a tension ratio, or None."""
+    if "mu1:mu2=" not in name:
+        return None
+    head, tail = name.split("mu1:mu2=", 1)
+    return head.replace(" coupled", "") + "mu1:mu2=1"
 
 
 def main(argv):
@@ -120,6 +139,31 @@ def main(argv):
         print(f"{'PASS' if same else 'FAIL'} {case}: the same DoFs, active "
               f"set iterations and active vertices on every cycle as {base}")
         ok &= bool(same)
+
+    iterations = {case: [int(row["active_set_iterations"])
+                         for row in report]
+                  for case, report in reports.items()}
+    worst = [(case, max(its[1:])) for case, its in iterations.items()
+             if len(its) > 1 and max(its[1:]) > MAX_ITERATIONS_AFTER_FIRST]
+    print(f"{'PASS' if not worst else 'FAIL'} at most "
+          f"{MAX_ITERATIONS_AFTER_FIRST} active set iterations on every "
+          f"cycle after the first")
+    for case, count in worst:
+        print(f"  {case}: {count}")
+    ok &= not worst
+
+    for case in cases:
+        reference = ratio_one_case(case)
+        if reference is None or reference == case:
+            continue
+        its, ref = iterations.get(case, []), iterations.get(reference, [])
+        n = min(len(its), len(ref))
+        within = bool(ref) and len(its) >= n > 0 and all(
+            its[i] <= ref[i] + 1 for i in range(n))
+        print(f"{'PASS' if within else 'FAIL'} {case}: at most one active "
+              f"set iteration more than {reference} on each of its "
+              f"{n} cycles")
+        ok &= within
     return 0 if ok else 1
 
 

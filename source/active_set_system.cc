@@ -102,11 +102,21 @@ namespace membranes
     VectorType                           &x,
     const double                          tolerance,
     ActiveSetStatistics                  &statistics,
-    const TrilinosWrappers::SparseMatrix *mesh_matrix)
+    const TrilinosWrappers::SparseMatrix *mesh_matrix,
+    const VectorType                     *scaling)
   {
     TimerOutput::Scope scope(timer, "solve");
+    if (scaling)
+      {
+        VectorType inverse(*scaling);
+        for (auto &entry : inverse)
+          entry = 1 / entry;
+        x.scale(inverse);
+      }
     statistics.linear_iterations +=
       linear_solver.solve(matrix, x, rhs, tolerance, mesh_matrix);
+    if (scaling)
+      x.scale(*scaling);
     constraints.distribute(x);
   }
 

@@ -1,8 +1,42 @@
+#include <Epetra_CrsMatrix.h>
+#include <cmath>
 #include <deal.II/dofs/dof_tools.h>
 #include <membranes/coupled_system.h>
 
 namespace membranes
 {
+  namespace
+  {
+    /**
+     * @p matrix ← D @p matrix D in place, for the diagonal D of @p scaling
+     * (ghosted: it holds the entries of every column of the locally owned
+     * rows).
+     */
+    void
+    scale_symmetrically(const TrilinosWrappers::SparseMatrix &matrix,
+                        const TrilinosWrappers::MPI::Vector  &scaling)
+    {
+      // Epetra's row views point into the matrix's storage, writable even
+      // through a const matrix (as in DecoupledSystem).
+      const Epetra_CrsMatrix &epetra = matrix.trilinos_matrix();
+      std::vector<double>     column_scaling(epetra.NumMyCols());
+      for (int c = 0; c < epetra.NumMyCols(); ++c)
+        column_scaling[c] = scaling[epetra.GCID64(c)];
+      for (int row = 0; row < epetra.NumMyRows(); ++row)
+        {
+          int     n_entries;
+          double *values;
+          int    *columns;
+          epetra.ExtractMyRowView(row, n_entries, values, columns);
+          const double row_scaling = scaling[epetra.GRID64(row)];
+          for (int k = 0; k < n_entries; ++k)
+            values[k] *= row_scaling * column_scaling[columns[k]];
+        }
+    }
+  } // namespace
+
+
+
   template <int dim>
   CoupledSystem<dim>::CoupledSystem(const Parameters::Solver  &parameters,
                                     const Discretization<dim> &discretization,
@@ -27,6 +61,7 @@ namespace membranes
                             const DiscreteAction<dim> &)
   {
     this->dof_handler           = &dof_handler;
+    this->locally_owned_dofs    = locally_owned_dofs;
     this->locally_relevant_dofs = locally_relevant_dofs;
 
     // The contact constraint u1(a) = u2(a) only ever couples DoFs of
@@ -41,6 +76,22 @@ namespace membranes
                                mesh_constraints,
                                locally_owned_dofs,
                                locally_relevant_dofs);
+
+    // The tension μ_i of the membrane of each locally owned DoF.
+    tension.reinit(locally_owned_dofs, this->mpi_communicator);
+    std::vector<types::global_dof_index> dof_indices(
+      dof_handler.get_fe().n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(dof_indices);
+          for (unsigned int i = 0; i < dof_indices.size(); ++i)
+            if (locally_owned_dofs.is_element(dof_indices[i]))
+              tension[dof_indices[i]] =
+                this->data
+                  .mu[dof_handler.get_fe().system_to_component_index(i).first];
+        }
+    tension.compress(VectorOperation::insert);
   }
 
 
@@ -48,9 +99,29 @@ namespace membranes
   template <int dim>
   void
   CoupledSystem<dim>::prepare(const VectorType &,
-                              const double,
+                              const LinearTolerances &,
                               ActiveSetStatistics &)
   {}
+
+
+
+  template <int dim>
+  typename CoupledSystem<dim>::VectorType
+  CoupledSystem<dim>::tension_scaling(const DiscreteAction<dim> &action,
+                                      const IndexSet &active_set) const
+  {
+    const double M       = this->data.mu[0] + this->data.mu[1];
+    VectorType   scaling = tension;
+    for (const auto &dofs : action.locally_relevant_vertices())
+      if (active_set.is_element(dofs[0]))
+        for (const auto dof : dofs)
+          if (locally_owned_dofs.is_element(dof))
+            scaling[dof] = M;
+    for (auto &entry : scaling)
+      entry = 1 / std::sqrt(entry);
+    scaling.compress(VectorOperation::insert);
+    return scaling;
+  }
 
 
 
@@ -59,9 +130,10 @@ namespace membranes
   CoupledSystem<dim>::solve(const DiscreteAction<dim> &action,
                             const IndexSet            &active_set,
                             VectorType                &solution,
-                            const double               tolerance,
+                            const LinearTolerances    &tolerances,
                             ActiveSetStatistics       &statistics)
   {
+    VectorType scaling;
     {
       TimerOutput::Scope scope(this->timer, "assembly");
       constraints.clear();
@@ -92,14 +164,44 @@ namespace membranes
           }
       this->system_matrix.compress(VectorOperation::add);
       this->system_rhs.compress(VectorOperation::add);
+
+      // The system scaled by D = diag(m_j^{-1/2}), m_j = μ_i for the DoFs
+      // of membrane i at inactive vertices and on ∂ω, μ1 + μ2 for both
+      // DoFs of an active vertex. Its residual D r then has the norm
+      // Σ_a (r_W,a² / μ̄ + r_S,a² / (μ1 + μ2)) (sums over active vertices
+      // only r_S), so one bound on it bounds r_S and r_W each on its own
+      // scale.
+      scaling = tension_scaling(action, active_set);
+      VectorType ghosted_scaling(locally_owned_dofs,
+                                 locally_relevant_dofs,
+                                 this->mpi_communicator);
+      ghosted_scaling = scaling;
+      scale_symmetrically(this->system_matrix, ghosted_scaling);
+      this->system_rhs.scale(scaling);
     }
 
+    const double tolerance =
+      std::min(tolerances.contact / std::sqrt(this->data.mu_bar),
+               tolerances.sum / std::sqrt(this->data.mu[0] + this->data.mu[1]));
     this->solve_linear_system(this->system_matrix,
                               this->system_rhs,
                               constraints,
                               solution,
                               tolerance,
-                              statistics);
+                              statistics,
+                              nullptr,
+                              &scaling);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::clear()
+  {
+    ActiveSetSystem<dim>::clear();
+    tension.clear();
+    constraints.clear();
   }
 
 

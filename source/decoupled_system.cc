@@ -251,9 +251,9 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::prepare(const VectorType    &solution,
-                                const double         tolerance,
-                                ActiveSetStatistics &statistics)
+  DecoupledSystem<dim>::prepare(const VectorType       &solution,
+                                const LinearTolerances &tolerances,
+                                ActiveSetStatistics    &statistics)
   {
     {
       TimerOutput::Scope scope(this->timer, "assembly");
@@ -273,8 +273,12 @@ namespace membranes
       assemble_operator();
     }
 
-    this->solve_linear_system(
-      laplace_matrix, sum_rhs, sum_constraints, sum, tolerance, statistics);
+    this->solve_linear_system(laplace_matrix,
+                              sum_rhs,
+                              sum_constraints,
+                              sum,
+                              tolerances.sum,
+                              statistics);
   }
 
 
@@ -282,10 +286,10 @@ namespace membranes
   template <int dim>
   void
   DecoupledSystem<dim>::solve(const DiscreteAction<dim> &,
-                              const IndexSet      &active_set,
-                              VectorType          &solution,
-                              const double         tolerance,
-                              ActiveSetStatistics &statistics)
+                              const IndexSet         &active_set,
+                              VectorType             &solution,
+                              const LinearTolerances &tolerances,
+                              ActiveSetStatistics    &statistics)
   {
     const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
     const double       M = mu1 + mu2;
@@ -332,7 +336,7 @@ namespace membranes
                               this->system_rhs,
                               difference_constraints,
                               difference,
-                              tolerance,
+                              tolerances.contact,
                               statistics,
                               &preconditioner_matrix);
 

@@ -20,7 +20,7 @@ namespace membranes
     , lambda_h_vector(nullptr)
     , loads_per_cell(0)
     , max_force(0)
-    , l2_force(0)
+    , max_contact_force(0)
   {}
 
 
@@ -190,31 +190,38 @@ namespace membranes
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
     // μ_i ∫|∇φ_a|² |u_ih(a)|; on fine meshes it cancels down to O(h²) and
-    // its rounding error is relative to that diagonal part.
+    // its rounding error is relative to that diagonal part. Likewise for
+    // the terms of the obstacle problem for w, whose combination
+    // (μ2 · membrane 1 + μ1 · membrane 2)/(μ1 + μ2) carries the rounding
+    // error of forces of tension μ̄.
     // The vectors of the locally owned DoFs, read at local_positions.
-    const double *const products  = stiffness_product.trilinos_vector()[0];
-    const double *const loads     = load_vector.trilinos_vector()[0];
-    const double *const values    = solution.trilinos_vector()[0];
-    double              local_max = 0, local_sum_of_squares = 0;
+    const double *const products = stiffness_product.trilinos_vector()[0];
+    const double *const loads    = load_vector.trilinos_vector()[0];
+    const double *const values   = solution.trilinos_vector()[0];
+    const double        mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
+    double              local_max = 0, local_contact_max = 0;
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
       {
-        const Vertex &a = interior_vertices[k];
+        const Vertex &a        = interior_vertices[k];
+        const auto   &position = local_positions[k];
         for (unsigned int i = 0; i < 2; ++i)
-          {
-            const int    position  = local_positions[k][i];
-            const double stiffness = products[position];
-            const double load      = loads[position];
-            const double size      = std::max(
-              {std::abs(stiffness),
-                    std::abs(load),
-                    data.mu[i] * a.stiffness_diagonal * std::abs(values[position])});
-            local_max = std::max(local_max, size);
-            local_sum_of_squares += size * size;
-          }
+          local_max = std::max({local_max,
+                                std::abs(products[position[i]]),
+                                std::abs(loads[position[i]]),
+                                data.mu[i] * a.stiffness_diagonal *
+                                  std::abs(values[position[i]])});
+        local_contact_max = std::max(
+          {local_contact_max,
+           std::abs(mu2 * products[position[0]] - mu1 * products[position[1]]) /
+             M,
+           std::abs(mu2 * loads[position[0]] - mu1 * loads[position[1]]) / M,
+           data.mu_bar * a.stiffness_diagonal *
+             std::max(std::abs(values[position[0]]),
+                      std::abs(values[position[1]]))});
       }
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
-    l2_force =
-      std::sqrt(Utilities::MPI::sum(local_sum_of_squares, mpi_communicator));
+    max_contact_force =
+      Utilities::MPI::max(local_contact_max, mpi_communicator);
   }
 
 
@@ -318,7 +325,9 @@ namespace membranes
   double
   DiscreteAction<dim>::lambda(const unsigned int k) const
   {
-    return (lambda_from_membrane(0, k) + lambda_from_membrane(1, k)) / 2;
+    return (data.mu[1] * lambda_from_membrane(0, k) +
+            data.mu[0] * lambda_from_membrane(1, k)) /
+           (data.mu[0] + data.mu[1]);
   }
 
 
@@ -334,9 +343,9 @@ namespace membranes
 
   template <int dim>
   double
-  DiscreteAction<dim>::force_scale_l2() const
+  DiscreteAction<dim>::contact_force_scale() const
   {
-    return l2_force;
+    return max_contact_force;
   }
 
 

@@ -148,7 +148,8 @@ namespace membranes
    *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a,
    *
    * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
-   * obstacle problem for w = u1 − u2, SPEC §1). Each iteration solves the
+   * obstacle problem for w = u1 − u2, DecoupledSystem). Each iteration
+   * solves the
    * linear problem W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the
    * coupled pair (CoupledSystem, `Solver/Method = coupled`) or on the sum
    * and the difference of the membranes (DecoupledSystem, `decoupled`).
@@ -175,14 +176,11 @@ namespace membranes
    * - an inactive vertex is activated iff Ŵ_a < −ε,
    * - every other vertex keeps its status (hysteresis).
    * The band is about that of the KKT residual: a vertex kept in it adds at
-   * most about ε to its dual (−λ_a d_a / F_∞, F_∞ ≥ μ̄ ∫|∇φ_a|² U_∞) or
+   * most about ε to its dual (−λ_a d_a / F^w_∞, F^w_∞ ≥ μ̄ ∫|∇φ_a|² U_∞) or
    * primal (−W_a / U_∞) feasibility part, so either status is an acceptable
-   * answer for it. The test uses the λ_a of the obstacle problem for w,
-   * (μ2 λ_1a + μ1 λ_2a) / (μ1 + μ2) with λ_ia from membrane i by (4.5) (the
-   * two agree by Prop. 12): its round-off is that of forces of tension μ̄,
-   * where the plain mean of the two would carry the round-off of the
-   * stiffer membrane, max(μ1, μ2)/μ̄ times larger than the band for a
-   * tension ratio of 1e8.
+   * answer for it. λ_a is DiscreteAction::lambda(), the multiplier of the
+   * obstacle problem for w: its rounding and algebraic errors are those of
+   * forces of tension μ̄, as the band is, whatever the tension ratio.
    *
    * <b>The next active set, predicted.</b> Where strict complementarity
    * fails at the free boundary (λ and u1 − u2 both vanish there, as in
@@ -216,18 +214,36 @@ namespace membranes
    * needs 3). Each sweep carries the contact
    * information one layer further: penetrated vertices are clamped and
    * lift their neighbours, active vertices pulled apart are released with
-   * the ones behind them. The prediction only proposes; the solve of the
-   * next iteration and the plain test decide, and convergence is judged on
-   * the iterate alone. If the prediction wants no change, or once a cycle
-   * has been detected on the mesh, the plain update is used, so that the
+   * the ones behind them. Where the predicted test is within the band of
+   * indifference, the prediction has nothing to say and the plain test on
+   * the iterate decides: a vertex that the solves keep penetrating by a
+   * few ε is clamped by the sweeps to a contact force within the band, and
+   * without the plain test it would stay inactive until the prediction
+   * wants no change at all (an extra iteration on the finest meshes of a
+   * degenerate free boundary). The prediction only proposes; the solve of
+   * the next iteration and the plain test decide, and convergence is
+   * judged on the iterate alone. If the prediction wants no change, or once a
+   * cycle has been detected on the mesh, the plain update is used, so that the
    * remedy against cycling below works on the plain test as before.
    *
    * <b>Convergence.</b> The iteration stops when no vertex wants to change
    * and the relative KKT residual (kkt_residual()) is at most `Tolerance`.
-   * If the active set has settled but the residual does not decrease any
-   * more (the accuracy of the linear solver limits it), or at
-   * `Max active set iterations`, solve() throws ActiveSetNotConverged with
-   * the residual reached. Cycling is detected and remedied by
+   * The linear solves are tied to that test (LinearTolerances): the problem
+   * for s and the obstacle problem for w each stop at the residual norm
+   * `Tolerance` times their own force scale, F_∞ and F^w_∞ of
+   * DiscreteAction, and a bound on the Euclidean norm bounds every nodal
+   * residual. An iterate on the right active set therefore meets the
+   * equilibrium, dual feasibility and complementarity parts of the test by
+   * construction, on meshes of any size and for any tension ratio (a bound
+   * relative to the Euclidean norm of all forces lets single residuals grow
+   * like the square root of the number of vertices, and one relative to the
+   * stiffer membrane leaves the obstacle problem of a tension ratio 1e8
+   * unresolved by eight orders). If the active set has settled but the test
+   * is not met (round-off, or vertices kept in the band), the same active
+   * set is solved again with residuals settled_tightening times smaller,
+   * from the same AMG hierarchy; if that does not decrease the residual, or
+   * at `Max active set iterations`, solve() throws ActiveSetNotConverged
+   * with the residual reached. Cycling is detected and remedied by
    * ActiveSetHistory.
    *
    * <b>Balanced stopping</b> (`Solver/Stopping = balanced`). On a mesh whose
@@ -327,13 +343,17 @@ namespace membranes
                        const VectorType          &ghosted_lambda_h) const;
 
     /**
-     * The relative KKT residual of an iterate, the largest of
-     * - equilibrium: ‖r‖₂ / F₂ with r_a = λ_a d_a from both membranes on
-     *   inactive vertices and the difference of the two on active ones;
-     * - primal feasibility: max(−W_a)⁺ / max|U|;
-     * - dual feasibility: max(−λ_a d_a)⁺ / F_∞;
-     * - complementarity: max |λ_a d_a W_a| / (F_∞ max|U|);
-     * with F₂, F_∞ the force scales of DiscreteAction.
+     * The relative KKT residual of an iterate, the largest of the defects
+     * of the two problems of DecoupledSystem, each on its own scale
+     * (F_∞, F^w_∞ of DiscreteAction, U_∞ = max|U|):
+     * - equilibrium of s: max |λ_1a − λ_2a| d_a / F_∞ (Prop. 12);
+     * - equilibrium of w: max |λ_a d_a| / F^w_∞ on inactive vertices;
+     * - primal feasibility: max(−W_a)⁺ / U_∞;
+     * - dual feasibility: max(−λ_a d_a)⁺ / F^w_∞;
+     * - complementarity: max |λ_a d_a W_a| / (F^w_∞ U_∞).
+     * All are maxima over the vertices, so none grows with the size of the
+     * mesh, and all are unchanged when the data are scaled or the
+     * membranes swap roles.
      */
     double
     kkt_residual(const DiscreteAction<dim> &action,
@@ -344,9 +364,9 @@ namespace membranes
     /** The scales of an iterate that decisions and residuals refer to. */
     struct Scales
     {
-      double force;        ///< F_∞ of DiscreteAction.
-      double force_l2;     ///< F₂ of DiscreteAction.
-      double displacement; ///< U_∞ = max|U|.
+      double force;         ///< F_∞ of DiscreteAction.
+      double contact_force; ///< F^w_∞ of DiscreteAction.
+      double displacement;  ///< U_∞ = max|U|.
     };
 
     Scales
@@ -360,6 +380,12 @@ namespace membranes
      * last two cycles, 40 none).
      */
     static constexpr unsigned int n_prediction_sweeps = 40;
+
+    /**
+     * How much smaller the residuals of the linear solves are made when
+     * the active set has settled but the KKT test has not been met.
+     */
+    static constexpr double settled_tightening = 100;
 
     /**
      * The changes of the active set after the iterate @p solution (locally
@@ -377,13 +403,16 @@ namespace membranes
      * The locally owned vertices whose status in @p active_set the test
      * Λ_a − c_a W_a > 0 (with the band of indifference) wants to change on
      * the iterate predicted from @p solution by n_prediction_sweeps sweeps
-     * of projected Jacobi (see the class documentation). Leaves in
+     * of projected Jacobi (see the class documentation); at the vertices
+     * where that test is within the band, those of @p plain_changes, the
+     * changes the plain test wants on @p solution itself. Leaves in
      * @p action the λ_a of the prediction.
      */
     std::vector<StatusChange>
-    predicted_changes(DiscreteAction<dim> &action,
-                      const VectorType    &solution,
-                      const IndexSet      &active_set) const;
+    predicted_changes(DiscreteAction<dim>             &action,
+                      const VectorType                &solution,
+                      const IndexSet                  &active_set,
+                      const std::vector<StatusChange> &plain_changes) const;
 
     /**
      * @p active_set (owned vertices) extended to the locally relevant
@@ -394,14 +423,6 @@ namespace membranes
     IndexSet
     locally_relevant_active_set(const DiscreteAction<dim> &action,
                                 const IndexSet            &active_set) const;
-
-    /**
-     * λ_a of the obstacle problem for w at the k-th vertex of @p action,
-     * (μ2 λ_1a + μ1 λ_2a) / (μ1 + μ2).
-     */
-    double
-    contact_lambda(const DiscreteAction<dim> &action,
-                   const unsigned int         k) const;
 
     /**
      * The locally owned vertices of @p action whose status in

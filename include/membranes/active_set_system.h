@@ -37,6 +37,26 @@ namespace membranes
 
 
   /**
+   * The residual norms at which the linear solves of one iteration stop.
+   *
+   * The linear problem of an iteration splits exactly (DecoupledSystem)
+   * into the problem for s = μ1 u1 + μ2 u2, whose residual at a vertex is
+   * r_S,a = (λ_1a − λ_2a) d_a (Prop. 12), and the obstacle problem for
+   * w = u1 − u2, whose residual at an inactive vertex is r_W,a = λ_a d_a
+   * (DiscreteAction::lambda()). The two are of different sizes,
+   * forces of tension μ1 + μ2 and μ̄ = μ1μ2/(μ1 + μ2), eight orders apart
+   * for a tension ratio of 1e8; each gets its own bound on the Euclidean
+   * norm of its residual, which also bounds each nodal residual.
+   */
+  struct LinearTolerances
+  {
+    double sum;     ///< Bound of ‖r_S‖₂.
+    double contact; ///< Bound of ‖r_W‖₂ (inactive vertices).
+  };
+
+
+
+  /**
    * The linear problem of one iteration of the primal-dual active set
    * method (ActiveSetSolver) for an active set A ⊂ V_h: find (u1h, u2h)
    * with u1h = g_h, u2h = g2_h on ∂ω, the hanging node constraints,
@@ -84,26 +104,25 @@ namespace membranes
     /**
      * Before the first iteration on a mesh, from the initial guess
      * @p solution: the work that does not depend on the active set, solved
-     * with a residual norm of at most @p tolerance.
+     * to the residual norms @p tolerances.
      */
     virtual void
-    prepare(const VectorType    &solution,
-            const double         tolerance,
-            ActiveSetStatistics &statistics) = 0;
+    prepare(const VectorType       &solution,
+            const LinearTolerances &tolerances,
+            ActiveSetStatistics    &statistics) = 0;
 
     /**
      * Solve the linear problem for @p active_set (u1 DoFs of the active
      * locally relevant vertices of @p action, so that every process knows
      * the constraints of the cells it assembles), starting from
-     * @p solution, with a residual
-     * norm of at most @p tolerance. On return @p solution holds (u1h, u2h),
-     * constraints included.
+     * @p solution, to the residual norms @p tolerances. On return
+     * @p solution holds (u1h, u2h), constraints included.
      */
     virtual void
     solve(const DiscreteAction<dim> &action,
           const IndexSet            &active_set,
           VectorType                &solution,
-          const double               tolerance,
+          const LinearTolerances    &tolerances,
           ActiveSetStatistics       &statistics) = 0;
 
     /**
@@ -157,6 +176,11 @@ namespace membranes
      * is built from @p mesh_matrix if given (a matrix unchanged on this
      * mesh, kept across solves: LinearSolver), from @p matrix for this
      * solve alone otherwise.
+     *
+     * With @p scaling, the diagonal D of a symmetric scaling (locally
+     * owned entries), @p matrix and @p rhs are D K D and D b of a system
+     * K x = b: the solve is for y = D⁻¹x, so that the residual norm is that
+     * of D(b − K x); @p x is given and returned unscaled.
      */
     void
     solve_linear_system(
@@ -166,7 +190,8 @@ namespace membranes
       VectorType                           &x,
       const double                          tolerance,
       ActiveSetStatistics                  &statistics,
-      const TrilinosWrappers::SparseMatrix *mesh_matrix = nullptr);
+      const TrilinosWrappers::SparseMatrix *mesh_matrix = nullptr,
+      const VectorType                     *scaling     = nullptr);
 
     /**
      * Whether the AMG hierarchy of a mesh matrix given to an earlier

@@ -22,6 +22,14 @@ namespace membranes
    * λ_a = 0. The condensed system changes with the active set and is
    * assembled at every iteration from the cell matrices of CellSystem and
    * the cell loads, which are computed once per mesh.
+   *
+   * The rows of the two membranes are forces of tensions μ1 and μ2, and of
+   * μ1 + μ2 where the contact constraint adds them: for tension ratios far
+   * from 1 they differ by orders of magnitude, and a Euclidean residual
+   * bound would leave the rows of the softer membrane unresolved. The
+   * system is therefore solved with the symmetric scaling by the tensions
+   * described in solve(), which measures its residual as the two problems
+   * of DecoupledSystem measure theirs (LinearTolerances).
    */
   template <int dim>
   class CoupledSystem : public ActiveSetSystem<dim>
@@ -47,24 +55,39 @@ namespace membranes
 
     /** Nothing: every part of the coupled system depends on the active set. */
     void
-    prepare(const VectorType    &solution,
-            const double         tolerance,
-            ActiveSetStatistics &statistics) override;
+    prepare(const VectorType       &solution,
+            const LinearTolerances &tolerances,
+            ActiveSetStatistics    &statistics) override;
 
     void
     solve(const DiscreteAction<dim> &action,
           const IndexSet            &active_set,
           VectorType                &solution,
-          const double               tolerance,
+          const LinearTolerances    &tolerances,
           ActiveSetStatistics       &statistics) override;
 
+    /** Also the tensions of the DoFs and the constraints. */
+    void
+    clear() override;
+
   private:
+    /**
+     * The diagonal m_j^{-1/2} of the scaling of the system of @p active_set
+     * (locally owned entries; see solve()).
+     */
+    VectorType
+    tension_scaling(const DiscreteAction<dim> &action,
+                    const IndexSet            &active_set) const;
+
     SmartPointer<const DoFHandler<dim>> dof_handler;
+    IndexSet                            locally_owned_dofs;
     IndexSet                            locally_relevant_dofs;
     /** Hanging node and boundary constraints of the mesh. */
     AffineConstraints<double> mesh_constraints;
     /** The same with the contact lines of the current active set. */
     AffineConstraints<double> constraints;
+    /** μ_i at each locally owned DoF of membrane i. */
+    VectorType tension;
   };
 } // namespace membranes
 

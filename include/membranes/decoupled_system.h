@@ -96,16 +96,16 @@ namespace membranes
      * A S = F1 + F2.
      */
     void
-    prepare(const VectorType    &solution,
-            const double         tolerance,
-            ActiveSetStatistics &statistics) override;
+    prepare(const VectorType       &solution,
+            const LinearTolerances &tolerances,
+            ActiveSetStatistics    &statistics) override;
 
     /** W for @p active_set, and (U1, U2) from S and W into @p solution. */
     void
     solve(const DiscreteAction<dim> &action,
           const IndexSet            &active_set,
           VectorType                &solution,
-          const double               tolerance,
+          const LinearTolerances    &tolerances,
           ActiveSetStatistics       &statistics) override;
 
     /**

@@ -204,7 +204,17 @@ namespace membranes
     double
     load_term(const unsigned int i, const unsigned int k) const;
 
-    /** λ_a: the mean of the two formulas of (4.5) (they agree by Prop. 12). */
+    /**
+     * λ_a from the two formulas of (4.5), which agree by Prop. 12, weighted
+     * as (μ2 λ_1a + μ1 λ_2a) / (μ1 + μ2): times d_a it is the residual
+     * μ̄ (A W)_a − G_a of the obstacle problem for w = u1 − u2
+     * (DecoupledSystem), G = (μ2 F1 − μ1 F2)/(μ1 + μ2), the multiplier of
+     * the active set method. Its rounding and algebraic errors are those
+     * of forces of tension μ̄ = μ1μ2/(μ1 + μ2); the plain mean of the two
+     * formulas would carry those of the stiffer membrane, max(μ1, μ2)/μ̄
+     * times larger (1e8 times for a tension ratio of 1e8). For μ1 = μ2 it
+     * is the mean.
+     */
     double
     lambda(const unsigned int k) const;
 
@@ -213,15 +223,23 @@ namespace membranes
      * i of the terms that (4.5) balances, |μ_i ∫ ∇u_ih·∇φ_a|, |∫ f_i φ_a|
      * and the diagonal part μ_i ∫|∇φ_a|² |u_ih(a)| of the first (whose
      * rounding error bounds how well the balance can be computed). What
-     * residuals and λ_a d_a are measured against; global over all
+     * the difference (λ_1a − λ_2a) d_a of Prop. 12, the residual of the
+     * problem for s = μ1 u1 + μ2 u2, is measured against; global over all
      * processes. It scales like the data.
      */
     double
     force_scale() const;
 
-    /** The same in the Euclidean norm over all vertices and membranes. */
+    /**
+     * The same for the forces of the obstacle problem for w = u1 − u2 that
+     * lambda() d_a balances: the max over a of |μ̄ (A W)_a|, |G_a|
+     * and μ̄ ∫|∇φ_a|² max_i |u_ih(a)|. What λ_a of the active set method
+     * is measured against. It is unchanged when the two membranes swap
+     * roles, and for tension ratios far from 1 it is the scale of the
+     * softer membrane, not of the stiffer one.
+     */
     double
-    force_scale_l2() const;
+    contact_force_scale() const;
 
   private:
     const Discretization<dim>    &discretization;
@@ -261,7 +279,7 @@ namespace membranes
     std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
     IndexSet                                            interior_vertex_dofs;
     double                                              max_force;
-    double                                              l2_force;
+    double                                              max_contact_force;
   };
 
 
