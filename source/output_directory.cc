@@ -8,16 +8,12 @@
 #include <membranes/atomic_file.h>
 #include <membranes/output_directory.h>
 #include <membranes/parameters.h>
+#include <membranes/version.h>
 #include <regex>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
-
-// The git commit the program is built from, set by CMake when it configures.
-#ifndef MEMBRANES_VERSION
-#  define MEMBRANES_VERSION "unknown"
-#endif
 
 namespace membranes
 {
