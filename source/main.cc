@@ -48,6 +48,30 @@ namespace
     "\n"
     "Exit status: 0 on success, 1 with a one-line message on any error.\n";
 
+  /**
+   * The command line @p argv, each word as a POSIX shell reads it back:
+   * in single quotes unless it consists of characters that need none.
+   */
+  std::string
+  command_line(const int argc, char **argv)
+  {
+    std::string line;
+    for (int i = 0; i < argc; ++i)
+      {
+        const std::string word = argv[i];
+        const bool        plain =
+          !word.empty() &&
+          word.find_first_not_of("abcdefghijklmnopqrstuvwxyz"
+                                 "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                 "_-+=/.,:@%") == std::string::npos;
+        std::string quoted = "'";
+        for (const char c : word)
+          quoted += (c == '\'' ? std::string("'\\''") : std::string(1, c));
+        line += (i == 0 ? "" : " ") + (plain ? word : quoted + "'");
+      }
+    return line;
+  }
+
   /** The number of CPUs in the affinity mask of this process. */
   unsigned int
   cpus_of_this_process()
@@ -135,22 +159,32 @@ main(int argc, char **argv)
 
       Parameters::All parameters;
       parameters.parse_parameters(prm);
-      // A relative mesh file is found next to the scene that names it.
+      // A relative mesh file is found next to the scene that names it; the
+      // record of the parameters names it by its absolute path, to be
+      // found from the output directory too.
       auto &mesh_file = parameters.geometry.mesh_file;
       if (!mesh_file.empty() && std::filesystem::path(mesh_file).is_relative())
-        mesh_file =
-          (std::filesystem::path(scene).parent_path() / mesh_file).string();
+        {
+          mesh_file =
+            (std::filesystem::path(scene).parent_path() / mesh_file).string();
+          Parameters::set_entry(
+            prm,
+            "Geometry/Mesh file=" +
+              std::filesystem::absolute(mesh_file).string());
+        }
 
-      MembraneProblem<2> problem(parameters);
+      MembraneProblem<2> problem(parameters,
+                                 {Parameters::parameter_file(prm),
+                                  command_line(argc, argv)});
       running = true;
       problem.run();
     }
   catch (const std::exception &e)
     {
-      // The active set method's decision to give up is made on global
-      // quantities: every process stops there with the same message.
+      // The active set method's decision to give up, the refusal of the
+      // output directory: every process stops there with the same message.
       const bool on_every_process =
-        dynamic_cast<const ActiveSetNotConverged *>(&e) != nullptr;
+        dynamic_cast<const Parameters::CollectiveError *>(&e) != nullptr;
       if (running && n_processes > 1 && !on_every_process)
         {
           std::cerr << "membranes: error (process " << process << " of "

@@ -12,7 +12,8 @@
 namespace membranes
 {
   template <int dim>
-  MembraneProblem<dim>::MembraneProblem(const Parameters::All &parameters)
+  MembraneProblem<dim>::MembraneProblem(const Parameters::All &parameters,
+                                        const Provenance      &provenance)
     : parameters(parameters)
     , mpi_communicator(MPI_COMM_WORLD)
     , pcout(std::cout, Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
@@ -34,6 +35,9 @@ namespace membranes
     , error_estimator(discretization, data)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
+    , output_directory(parameters.output.directory,
+                       provenance,
+                       mpi_communicator)
   {}
 
 
@@ -60,7 +64,8 @@ namespace membranes
    * exists must be a directory, and in the deepest one that exists a
    * directory must be creatable (a probe, removed at once; a read-only or
    * virtual file system such as /proc refuses it). The directory itself is
-   * created after the first cycle (create_output_directory()).
+   * created when the run claims it (OutputDirectory::claim()), after the
+   * checks of the data on the coarse mesh.
    */
   template <int dim>
   void
@@ -111,27 +116,14 @@ namespace membranes
 
 
 
-  /**
-   * Created only when the first results are there to be written, so that a
-   * scene whose data fail a check on the first mesh (where every expression
-   * is first evaluated) leaves nothing behind.
-   */
+  /** A directory for output besides `Output/Directory` (unconverged/). */
   template <int dim>
   void
   MembraneProblem<dim>::create_output_directory(
     const std::string &directory) const
   {
     if (pcout.is_active())
-      {
-        std::error_code error;
-        std::filesystem::create_directories(directory, error);
-        if (error || !std::filesystem::is_directory(directory))
-          throw Parameters::invalid_entry(
-            "Output/Directory",
-            directory,
-            "cannot create this directory (" +
-              (error ? error.message() : "a file of that name exists") + ")");
-      }
+      create_directory(directory);
     // The other processes write their own pieces into it.
     const int ierr = MPI_Barrier(mpi_communicator);
     AssertThrowMPI(ierr);
@@ -679,6 +671,7 @@ namespace membranes
   MembraneProblem<dim>::run()
   {
     make_grid();
+    output_directory.claim();
     double cumulative_time = 0;
     for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
       {
@@ -743,8 +736,6 @@ namespace membranes
               << " active set iterations, " << record.active_vertices
               << " active vertices, " << record.wall_time << " s" << std::endl;
 
-        if (cycle == 0)
-          create_output_directory(parameters.output.directory);
         report.add(record);
         previous_record = record;
         output_results(cycle);

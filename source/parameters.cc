@@ -187,16 +187,14 @@ namespace membranes::Parameters
     }
 
     /**
-     * The declared parameters as ParameterHandler holds them: a tree whose
-     * nodes are the subsections and the entries, in declaration order; an
-     * entry has the children `value`, `pattern_description`, ... (deal.II's
-     * JSON description of the parameters).
+     * The parameters of @p prm as it holds them: a tree whose nodes are the
+     * subsections and the entries, in declaration order; an entry has the
+     * children `value`, `pattern_description`, ... (deal.II's JSON
+     * description of the parameters).
      */
     ptree
-    declarations()
+    tree_of(const ParameterHandler &prm)
     {
-      ParameterHandler prm;
-      All::declare_parameters(prm);
       std::stringstream json;
       prm.print_parameters(json,
                            ParameterHandler::OutputStyle(
@@ -205,6 +203,15 @@ namespace membranes::Parameters
       ptree tree;
       boost::property_tree::read_json(json, tree);
       return tree;
+    }
+
+    /** The declared parameters, with their defaults (see tree_of()). */
+    ptree
+    declarations()
+    {
+      ParameterHandler prm;
+      All::declare_parameters(prm);
+      return tree_of(prm);
     }
 
     /** Whether @p node of declarations() is an entry, not a subsection. */
@@ -476,6 +483,58 @@ namespace membranes::Parameters
     prm.set(entry, value);
     for (unsigned int i = 0; i < subsections.size(); ++i)
       prm.leave_subsection();
+  }
+
+
+
+  namespace
+  {
+    /**
+     * The first entry of @p tree (of tree_of()) below the subsections
+     * @p path whose value a parameter file cannot hold: with a line break,
+     * a '#' (a comment starts there) or a '\\' at the end (which joins
+     * the next line); as `Subsection/Entry` and its value, empty if there
+     * is none.
+     */
+    std::pair<std::string, std::string>
+    first_unwritable(const ptree                    &tree,
+                     const std::vector<std::string> &path = {})
+    {
+      for (const auto &[name, node] : tree)
+        if (is_entry(node))
+          {
+            const auto value = node.get<std::string>("value");
+            if (value.find_first_of("#\n\r") != std::string::npos ||
+                (!value.empty() && value.back() == '\\'))
+              return {joined(path, name), value};
+          }
+        else
+          {
+            std::vector<std::string> below = path;
+            below.push_back(name);
+            if (auto found = first_unwritable(node, below);
+                !found.first.empty())
+              return found;
+          }
+      return {};
+    }
+  } // namespace
+
+
+
+  std::string
+  parameter_file(const ParameterHandler &prm)
+  {
+    const auto [entry, value] = first_unwritable(tree_of(prm));
+    if (!entry.empty())
+      throw invalid_entry(entry,
+                          value,
+                          "parameters.prm, the record of the run, cannot "
+                          "hold a line break, a '#' (a comment starts there) "
+                          "or a '\\' at the end of a value");
+    std::ostringstream text;
+    prm.print_parameters(text, ParameterHandler::PRM);
+    return text.str();
   }
 
 
@@ -904,8 +963,11 @@ namespace membranes::Parameters
     prm.declare_entry("Directory",
                       "output",
                       dealii::Patterns::DirectoryName(),
-                      "Directory for report.csv and the field output; created "
-                      "if missing.");
+                      "Directory for report.csv, the field output, "
+                      "parameters.prm and run-info.txt; created if missing. "
+                      "One run at a time holds it, and removes the files "
+                      "that an earlier run wrote there (those only) before "
+                      "its first cycle.");
     prm.declare_entry("Report",
                       "true",
                       Bool(),

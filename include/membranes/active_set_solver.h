@@ -14,7 +14,6 @@
 #include <membranes/problem_data.h>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <vector>
 
 namespace membranes
@@ -27,11 +26,12 @@ namespace membranes
    * changes but the relative KKT residual stays above `Solver/Tolerance`.
    * The message says which and the residual reached; the solution and the
    * active set passed to ActiveSetSolver::solve() hold the last iterate.
+   * The decision is made on global quantities: every process throws it.
    */
-  class ActiveSetNotConverged : public std::runtime_error
+  class ActiveSetNotConverged : public Parameters::CollectiveError
   {
   public:
-    using std::runtime_error::runtime_error;
+    using Parameters::CollectiveError::CollectiveError;
   };
 
 

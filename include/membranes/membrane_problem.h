@@ -16,6 +16,7 @@
 #include <membranes/error_norms.h>
 #include <membranes/field_output.h>
 #include <membranes/flux_reconstruction.h>
+#include <membranes/output_directory.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <membranes/report.h>
@@ -31,10 +32,11 @@ namespace membranes
    * solved by the primal-dual active set method on a sequence of meshes,
    * with the action λ_h by the local postprocessing (4.5).
    *
-   * run() is the whole story: for each cycle, refine the last mesh
-   * (globally, or by the estimator's indicators), set up DoFs and
-   * constraints, transfer the previous solution and active set to the new
-   * mesh (nested iteration), solve, postprocess (λ_h, the discrete
+   * run() is the whole story: make the coarse mesh and check the data on
+   * it, claim the output directory (OutputDirectory), then for each cycle,
+   * refine the last mesh (globally, or by the estimator's indicators), set
+   * up DoFs and constraints, transfer the previous solution and active set to
+   * the new mesh (nested iteration), solve, postprocess (λ_h, the discrete
    * identities, errors), reconstruct the fluxes t_ih (if the scene asks for
    * them), estimate the error, add a row to the report, write fields.
    *
@@ -51,7 +53,12 @@ namespace membranes
   class MembraneProblem
   {
   public:
-    explicit MembraneProblem(const Parameters::All &parameters);
+    /**
+     * The run of @p parameters; @p provenance is recorded in its output
+     * directory (OutputDirectory).
+     */
+    MembraneProblem(const Parameters::All &parameters,
+                    const Provenance      &provenance);
 
     void
     run();
@@ -130,6 +137,8 @@ namespace membranes
     ErrorEstimator<dim>     error_estimator;
     Report                  report;
     FieldOutput<dim>        field_output;
+    /** Held from the start of the first cycle to the end of the run. */
+    OutputDirectory output_directory;
 
     /**
      * Carries (u_h, λ_h) from one mesh to the next: the distributed

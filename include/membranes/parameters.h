@@ -27,6 +27,18 @@ namespace membranes::Parameters
   };
 
   /**
+   * An error that every process meets alike, because it is decided on
+   * global quantities or by the first process and made known to all: every
+   * process ends with exit status 1 and the first one prints the message
+   * (no MPI_Abort).
+   */
+  class CollectiveError : public std::runtime_error
+  {
+  public:
+    using std::runtime_error::runtime_error;
+  };
+
+  /**
    * The message of @p error on one line of printable text: deal.II's
    * description of its exceptions, or what(); line breaks, control
    * characters and runs of blanks become one blank, bytes that are not
@@ -85,6 +97,18 @@ namespace membranes::Parameters
    */
   void
   set_entry(ParameterHandler &prm, const std::string &assignment);
+
+  /**
+   * Every parameter of @p prm, defaults included, as a parameter file in
+   * deal.II's PRM style (each entry with its documentation), which
+   * read_scene() reads back to the same values: what a run records in its
+   * output directory as parameters.prm. A value that a parameter file
+   * cannot hold (a line break; a '#', which starts a comment there; a '\\'
+   * at the end, which continues the line) is an InputError naming its
+   * entry.
+   */
+  std::string
+  parameter_file(const ParameterHandler &prm);
 
   enum class Domain
   {
