@@ -36,6 +36,9 @@ namespace membranes
      * arguments to the nearest integer; `?:`, `&&`, `||` test against 0).
      */
     const char *const prelude = R"(#include <cmath>
+// Every function of the prelude is small: inlined into the expression, so
+// that a dual number's components stay in registers.
+#define MEMBRANES_INLINE inline __attribute__((always_inline))
 namespace
 {
   using std::abs; using std::acos; using std::acosh; using std::asin;
@@ -55,7 +58,7 @@ namespace
       for (T &e : d)
         e = T(0.);
     }
-    friend Dual operator-(const Dual &a)
+    friend MEMBRANES_INLINE Dual operator-(const Dual &a)
     {
       Dual r;
       r.v = -a.v;
@@ -63,7 +66,7 @@ namespace
         r.d[i] = -a.d[i];
       return r;
     }
-    friend Dual operator+(const Dual &a, const Dual &b)
+    friend MEMBRANES_INLINE Dual operator+(const Dual &a, const Dual &b)
     {
       Dual r;
       r.v = a.v + b.v;
@@ -71,7 +74,7 @@ namespace
         r.d[i] = a.d[i] + b.d[i];
       return r;
     }
-    friend Dual operator-(const Dual &a, const Dual &b)
+    friend MEMBRANES_INLINE Dual operator-(const Dual &a, const Dual &b)
     {
       Dual r;
       r.v = a.v - b.v;
@@ -79,7 +82,7 @@ namespace
         r.d[i] = a.d[i] - b.d[i];
       return r;
     }
-    friend Dual operator*(const Dual &a, const Dual &b)
+    friend MEMBRANES_INLINE Dual operator*(const Dual &a, const Dual &b)
     {
       Dual r;
       r.v = a.v * b.v;
@@ -87,7 +90,7 @@ namespace
         r.d[i] = a.d[i] * b.v + a.v * b.d[i];
       return r;
     }
-    friend Dual operator/(const Dual &a, const Dual &b)
+    friend MEMBRANES_INLINE Dual operator/(const Dual &a, const Dual &b)
     {
       Dual r;
       r.v = a.v / b.v;
@@ -111,7 +114,7 @@ namespace
   }
 
   // f(a) with f'(a) = df, by the chain rule.
-  template <class T> Dual<T> chain(const Dual<T> &a, const T &f, const T &df)
+  template <class T> MEMBRANES_INLINE Dual<T> chain(const Dual<T> &a, const T &f, const T &df)
   {
     Dual<T> r;
     r.v = f;
@@ -121,7 +124,7 @@ namespace
   }
 
 #define MEMBRANES_UNARY(f, df)                                          \
-  template <class T> Dual<T> f(const Dual<T> &a)                        \
+  template <class T> MEMBRANES_INLINE Dual<T> f(const Dual<T> &a)                        \
   {                                                                     \
     const T &x = a.v;                                                   \
     return chain(a, T(f(x)), T(df));                                    \
@@ -175,7 +178,7 @@ namespace
   template <class T> T csc(const T &a) { return 1. / sin(a); }
   template <class T> T sec(const T &a) { return 1. / cos(a); }
   // a^k for an integer k, by repeated squaring, unrolled at compile time.
-  template <int k, class T> T ipow(const T &a)
+  template <int k, class T> MEMBRANES_INLINE T ipow(const T &a)
   {
     if constexpr (k < 0)
       return 1. / ipow<-k>(a);
@@ -599,7 +602,8 @@ namespace
         {
           const std::string e = "expression_" + std::to_string(i);
           const std::string s = std::to_string(i);
-          out << "template <class T> T " << e << "(const T *v) { return "
+          out << "template <class T> MEMBRANES_INLINE T " << e
+              << "(const T *v) { return "
               << Translator(requests[i].expression, variables, constants)
                    .translate()
               << "; }\n"
@@ -640,6 +644,7 @@ namespace
 
     const std::vector<std::string> compiler_flags{"-std=c++17",
                                                   "-O2",
+                                                  "-fno-math-errno",
                                                   "-fPIC",
                                                   "-shared",
                                                   "-w"};
