@@ -4,8 +4,9 @@
 #   benchmarks/peer_snesvi.sh [path/to/membranes] [output-dir]
 #
 # Defaults: build/membranes of this repository and /tmp/membranes-peer.
-# Solves parameters/degenerate-free-boundary.prm (P1, global refinement,
-# 7 cycles from 162 to 526 338 DoFs) twice, one run after the other:
+# Solves parameters/degenerate-free-boundary.prm, or another scene (SCENE,
+# below), (P1, global refinement, 7 cycles from 162 to 526 338 DoFs) twice,
+# one run after the other:
 #
 #   peer       benchmarks/peer_snesvi.py: FEniCSx 0.5 (python3-dolfinx),
 #              the same vertex grids and DoF counts, SNES vinewtonrsls with
@@ -34,7 +35,27 @@ levels=${LEVELS:-7}
 peer=$root/benchmarks/peer_snesvi.py
 # The interpreter of Debian's python3-dolfinx.
 python=/usr/bin/python3
-scene=$root/parameters/degenerate-free-boundary.prm
+# SCENE=degenerate (default) or shifted-circle; EVALUATION=auto (default),
+# compiled or parser: membranes' Problem/Expression evaluation. With the
+# parser, the degenerate scene is tests/scenes/degenerate-free-boundary-
+# loads.prm (its data written out). The shifted circle is always
+# tests/scenes/shifted-circle-loads.prm (long expressions as written by hand,
+# mu1 = 1, mu2 = 2).
+peer_scene=${SCENE:-degenerate}
+evaluation=${EVALUATION:-auto}
+case $peer_scene in
+  degenerate)
+    scene=$root/parameters/degenerate-free-boundary.prm
+    [[ $evaluation == parser ]] &&
+      scene=$root/tests/scenes/degenerate-free-boundary-loads.prm
+    tensions=(--mu1 1 --mu2 1) ;;
+  shifted-circle)
+    scene=$root/tests/scenes/shifted-circle-loads.prm
+    tensions=(--mu1 1 --mu2 2) ;;
+  *)
+    echo "peer_snesvi.sh: error: SCENE=$peer_scene is not degenerate or shifted-circle" >&2
+    exit 1 ;;
+esac
 
 if ! $python -c 'import dolfinx' 2>/dev/null; then
   echo "peer_snesvi.sh: error: $python cannot import dolfinx; install it with 'apt-get install python3-dolfinx'" >&2
@@ -62,10 +83,13 @@ run_timed() {
 
 echo "== $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start"
 echo "== filling the FFCx cache (untimed)"
-$python "$peer" --levels 1 --output "$out/cache.csv" >"$out/cache.log" 2>&1
+$python "$peer" --scene "$peer_scene" "${tensions[@]}" --levels 1 \
+  --output "$out/cache.csv" >"$out/cache.log" 2>&1
 rm -f "$out/peer.csv" "$out/membranes/report.csv"
-run_timed peer $python "$peer" --levels "$levels" --output "$out/peer.csv"
+run_timed peer $python "$peer" --scene "$peer_scene" "${tensions[@]}" \
+  --levels "$levels" --output "$out/peer.csv"
 run_timed membranes "$membranes" --set "Output/Write vtu=false" \
+  --set "Problem/Expression evaluation=$evaluation" \
   --set "Output/Directory=$out/membranes" \
   --set "Refinement/Cycles=$levels" "$scene"
 echo "== load average $(cut -d' ' -f1-3 /proc/loadavg) at end"

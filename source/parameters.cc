@@ -603,6 +603,10 @@ namespace membranes::Parameters
                                        Marking::fixed_fraction}};
     const Choices<Estimator> estimators{{"residual", Estimator::residual},
                                         {"flux", Estimator::flux}};
+    const Choices<ExpressionEvaluation> evaluations{
+      {"auto", ExpressionEvaluation::automatic},
+      {"compiled", ExpressionEvaluation::compiled},
+      {"parser", ExpressionEvaluation::parser}};
 
     /** The Selection pattern of @p choices: their words, in this order. */
     template <typename Enum>
@@ -722,6 +726,14 @@ namespace membranes::Parameters
                       dealii::Patterns::Anything(),
                       "Height of membrane 2 on the boundary (the paper: 0); "
                       "g - g2 >= 0.");
+    prm.declare_entry("Expression evaluation",
+                      "auto",
+                      selection(evaluations),
+                      "compiled: the expressions are translated to C++, "
+                      "compiled with the compiler that built the program "
+                      "(or $MEMBRANES_CXX) and cached; parser: muparser "
+                      "interprets them; auto: compiled if a compiler works, "
+                      "else the parser.");
     prm.leave_subsection();
   }
 
@@ -746,6 +758,8 @@ namespace membranes::Parameters
     f2                 = prm.get("f2");
     g                  = prm.get("g");
     g2                 = prm.get("g2");
+    expression_evaluation =
+      selected(prm, "Problem/Expression evaluation", evaluations);
     prm.leave_subsection();
   }
 
@@ -777,6 +791,14 @@ namespace membranes::Parameters
                       "",
                       dealii::Patterns::Anything(),
                       "Gradient of the exact u2, likewise.");
+    prm.declare_entry("Manufactured data",
+                      "false",
+                      Bool(),
+                      "Derive the data from u1, u2, lambda above: f1 = "
+                      "-mu1 Laplace(u1) - lambda, f2 = -mu2 Laplace(u2) + "
+                      "lambda, g = u1 and g2 = u2 on the boundary (Problem/"
+                      "f1, f2, g, g2 are then not set). Needs compiled "
+                      "expressions.");
     prm.leave_subsection();
   }
 
@@ -784,12 +806,13 @@ namespace membranes::Parameters
   ExactSolution::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Exact solution");
-    known       = prm.get_bool("Known");
-    u1          = prm.get("u1");
-    u2          = prm.get("u2");
-    lambda      = prm.get("lambda");
-    u1_gradient = prm.get("u1 gradient");
-    u2_gradient = prm.get("u2 gradient");
+    known        = prm.get_bool("Known");
+    u1           = prm.get("u1");
+    u2           = prm.get("u2");
+    lambda       = prm.get("lambda");
+    u1_gradient  = prm.get("u1 gradient");
+    u2_gradient  = prm.get("u2 gradient");
+    manufactured = prm.get_bool("Manufactured data");
     prm.leave_subsection();
   }
 
@@ -1039,5 +1062,26 @@ namespace membranes::Parameters
                           std::to_string(refinement.coarsen_fraction),
                           "deal.II 9.4 cannot coarsen triangle meshes: use 0 "
                           "with 'Cell type = triangle'");
+    if (exact_solution.manufactured)
+      {
+        if (problem.expression_evaluation == ExpressionEvaluation::parser)
+          throw invalid_entry(
+            "Exact solution/Manufactured data",
+            "true",
+            "derives the loads by differentiating the compiled expressions "
+            "of u1, u2: use it with Problem/Expression evaluation = auto or "
+            "compiled, not parser");
+        // The data that it derives: left at their defaults ("0").
+        for (const auto &[entry, value] : {std::pair{"Problem/f1", problem.f1},
+                                           std::pair{"Problem/f2", problem.f2},
+                                           std::pair{"Problem/g", problem.g},
+                                           std::pair{"Problem/g2", problem.g2}})
+          if (trim(value) != "0")
+            throw invalid_entry(entry,
+                                value,
+                                "not set with Exact solution/Manufactured "
+                                "data = true, which derives it from u1, u2 "
+                                "and lambda");
+      }
   }
 } // namespace membranes::Parameters

@@ -7,7 +7,10 @@ Usage::
                    report.csv[=LABEL] [more.csv[=LABEL] ...]
 
 Draws one figure with two log-log panels: errors versus number of degrees of
-freedom (left) and errors versus cumulative wall time (right).  By default
+freedom (left) and errors versus cumulative wall time (right), the time of
+the method: ``cumulative_wall_time_s`` does not contain the error norms
+against the exact solution (``time_errors_s``), which a run without one
+never computes.  By default
 every ``err_*`` column that holds values is plotted, plus ``estimator`` when
 it is present and non-empty; ``--columns`` names the columns to plot instead
 (e.g. ``--columns err_energy,estimator``), in the order given.  A named
@@ -248,7 +251,7 @@ def make_figure(series_list, title, selection=None):
     figure, (left, right) = pyplot.subplots(1, 2, figsize=(13, 5.5))
     plot_panel(left, series_list, colours, DOFS, "degrees of freedom N")
     plot_panel(right, series_list, colours, TIME,
-               "cumulative wall time [s]")
+               "cumulative wall time of the method [s] (without error norms)")
     slopes = add_reference_slopes(left, series_list, quantities)
 
     quantity_handles, file_handles = legend_handles(series_list, colours)

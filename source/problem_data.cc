@@ -6,8 +6,11 @@
 #include <deal.II/base/thread_local_storage.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/grid/manifold.h>
+#include <functional>
+#include <membranes/compiled_function.h>
 #include <membranes/problem_data.h>
 #include <muParser.h>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -139,69 +142,18 @@ namespace membranes
 
 
     /**
-     * The expressions of one entry of the scene, separated by ';' (one for
-     * a function, dim for a gradient, as deal.II's FunctionParser reads a
-     * function with that many components), each in a muparser object set up
-     * by set_up(), their variables bound to the coordinates of one point.
+     * An entry of the scene that holds an expression, and the checks of its
+     * values: one that is not finite, or larger than max_magnitude in
+     * magnitude, is an InputError naming the entry and the point.
      */
     template <int dim>
-    class ParsedEntry
+    class Entry
     {
     public:
-      /**
-       * Parse @p text, the value of entry @p entry, as @p n_components
-       * expressions with @p constants and the variables bound to @p point.
-       * Each is evaluated once at the origin, so that a syntax error or an
-       * unknown name surfaces here, as an InputError naming the entry,
-       * rather than mid-run; its value there is not checked (the origin
-       * need not be in the domain: the L-shape's loads are singular at its
-       * corner).
-       */
-      ParsedEntry(const std::string                   &entry,
-                  const std::string                   &text,
-                  const unsigned int                   n_components,
-                  const std::map<std::string, double> &constants,
-                  Point<dim>                          &point)
+      Entry(const std::string &entry, const std::string &text)
         : entry(entry)
         , text(text)
-      {
-        const auto expressions = Utilities::split_string_list(text, ';');
-        if (expressions.size() != n_components)
-          throw invalid("expected " + std::to_string(n_components) +
-                        (n_components == 1 ?
-                           " expression in x, y" :
-                           " expressions in x, y separated by ';', "
-                           "the derivatives by x and by y") +
-                        ", found " + std::to_string(expressions.size()));
-        for (unsigned int c = 0; c < n_components; ++c)
-          try
-            {
-              parsers.push_back(std::make_unique<mu::Parser>());
-              set_up(*parsers.back(), expressions[c], constants, point);
-              point = Point<dim>();
-              parsers.back()->Eval();
-            }
-          catch (const mu::ParserError &e)
-            {
-              throw invalid(
-                "not a valid expression in x, y (" +
-                (n_components == 1 ? "" : "'" + expressions[c] + "': ") +
-                e.GetMsg() + ")");
-            }
-      }
-
-      /**
-       * Expression @p c at the point that the variables are bound to: one
-       * run of muparser's bytecode, with no lock and no lookup (unlike
-       * FunctionParser::value(), which finds its parser in thread-local
-       * storage on every call; Expression finds the parsers of its thread
-       * once for all the points of a cell).
-       */
-      double
-      evaluate(const unsigned int c) const
-      {
-        return parsers[c]->Eval();
-      }
+      {}
 
       /** The InputError for this entry, which should be @p allowed. */
       Parameters::InputError
@@ -221,6 +173,17 @@ namespace membranes
           throw out_of_range(value, p, what);
       }
 
+      /** Check the dim derivatives of @p gradient at @p p. */
+      void
+      check(const Tensor<1, dim> &gradient, const Point<dim> &p) const
+      {
+        static const char *const derivatives[] = {"derivative by x",
+                                                  "derivative by y",
+                                                  "derivative by z"};
+        for (unsigned int d = 0; d < dim; ++d)
+          check(gradient[d], p, derivatives[d]);
+      }
+
     private:
       /** The InputError of check(), kept out of its fast path. */
       Parameters::InputError
@@ -236,8 +199,77 @@ namespace membranes
         return invalid(allowed.str());
       }
 
-      const std::string                        entry;
-      const std::string                        text;
+      const std::string entry;
+      const std::string text;
+    };
+
+
+
+    /**
+     * The expressions of one entry of the scene, separated by ';' (one for
+     * a function, dim for a gradient, as deal.II's FunctionParser reads a
+     * function with that many components), each in a muparser object set up
+     * by set_up(), their variables bound to the coordinates of one point.
+     */
+    template <int dim>
+    class ParsedEntry : public Entry<dim>
+    {
+    public:
+      /**
+       * Parse @p text, the value of entry @p entry, as @p n_components
+       * expressions with @p constants and the variables bound to @p point.
+       * Each is evaluated once at the origin, so that a syntax error or an
+       * unknown name surfaces here, as an InputError naming the entry,
+       * rather than mid-run; its value there is not checked (the origin
+       * need not be in the domain: the L-shape's loads are singular at its
+       * corner).
+       */
+      ParsedEntry(const std::string                   &entry,
+                  const std::string                   &text,
+                  const unsigned int                   n_components,
+                  const std::map<std::string, double> &constants,
+                  Point<dim>                          &point)
+        : Entry<dim>(entry, text)
+      {
+        const auto expressions = Utilities::split_string_list(text, ';');
+        if (expressions.size() != n_components)
+          throw this->invalid("expected " + std::to_string(n_components) +
+                              (n_components == 1 ?
+                                 " expression in x, y" :
+                                 " expressions in x, y separated by ';', "
+                                 "the derivatives by x and by y") +
+                              ", found " + std::to_string(expressions.size()));
+        for (unsigned int c = 0; c < n_components; ++c)
+          try
+            {
+              parsers.push_back(std::make_unique<mu::Parser>());
+              set_up(*parsers.back(), expressions[c], constants, point);
+              point = Point<dim>();
+              parsers.back()->Eval();
+            }
+          catch (const mu::ParserError &e)
+            {
+              throw this->invalid(
+                "not a valid expression in x, y (" +
+                (n_components == 1 ? "" : "'" + expressions[c] + "': ") +
+                e.GetMsg() + ")");
+            }
+      }
+
+      /**
+       * Expression @p c at the point that the variables are bound to: one
+       * run of muparser's bytecode, with no lock and no lookup (unlike
+       * FunctionParser::value(), which finds its parser in thread-local
+       * storage on every call; Expression finds the parsers of its thread
+       * once for all the points of a cell).
+       */
+      double
+      evaluate(const unsigned int c) const
+      {
+        return parsers[c]->Eval();
+      }
+
+    private:
       std::vector<std::unique_ptr<mu::Parser>> parsers;
     };
   } // namespace
@@ -254,16 +286,20 @@ namespace membranes
    * infinity never enters a computation unnoticed, wherever the expression
    * produces it.
    *
-   * The gradient is given by a second entry when the scene has one (the
-   * exact gradients of the displacements); otherwise it is the central
-   * difference of the expression with the step of set_gradient_step().
+   * The values come from compiled code once use_compiled() has been called
+   * (CompiledFunctions), and the gradient then from its dual numbers; an
+   * expression that is only derived (the manufactured loads) has compiled
+   * values only. Otherwise muparser evaluates the expression, and the
+   * gradient is given by a second entry when the scene has one (the exact
+   * gradients of the displacements), or else it is the central difference
+   * of the expression with the step of set_gradient_step().
    *
-   * The loops over cells run on several threads (WorkStream), and a
-   * muparser object evaluates at the point its variables are bound to: so
-   * every thread has its own parsers and point, made on its first
-   * evaluation. They are found once per call of value_list() or
-   * gradient_list() (one lookup for all the points of a cell), not once
-   * per point.
+   * The loops over cells run on several threads (WorkStream). Compiled
+   * code has no state; a muparser object evaluates at the point its
+   * variables are bound to: so every thread has its own parsers and point,
+   * made on its first evaluation. They are found once per call of
+   * value_list() or gradient_list() (one lookup for all the points of a
+   * cell), not once per point.
    */
   template <int dim>
   class ProblemData<dim>::Expression : public Function<dim>
@@ -280,7 +316,8 @@ namespace membranes
                const std::map<std::string, double> &constants,
                const std::string                   &gradient_entry      = "",
                const std::string                   &gradient_expression = "")
-      : entry(entry)
+      : checks(entry, expression)
+      , entry(entry)
       , expression(expression)
       , constants(constants)
       , gradient_entry(gradient_entry)
@@ -289,10 +326,38 @@ namespace membranes
       parsers();
     }
 
+    /**
+     * An expression derived from others, described by @p description in
+     * the messages about entry @p entry, with the values @p compiled_value.
+     */
+    Expression(const std::string                              &entry,
+               const std::string                              &description,
+               const std::function<double(const Point<dim> &)> compiled_value)
+      : checks(entry, description)
+      , compiled_value(compiled_value)
+    {}
+
+    /**
+     * Evaluate by @p value and, if not empty, the gradient by @p gradient
+     * from now on.
+     */
+    void
+    use_compiled(
+      const std::function<double(const Point<dim> &)>         &value,
+      const std::function<Tensor<1, dim>(const Point<dim> &)> &gradient)
+    {
+      compiled_value    = value;
+      compiled_gradient = gradient;
+    }
+
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
-      return parsers().value(p);
+      if (!compiled_value)
+        return parsers().value(p);
+      const double result = compiled_value(p);
+      checks.check(result, p, "value");
+      return result;
     }
 
     void
@@ -300,15 +365,28 @@ namespace membranes
                std::vector<double>           &values,
                const unsigned int = 0) const override
     {
-      const ThreadParsers &local = parsers();
-      for (unsigned int q = 0; q < points.size(); ++q)
-        values[q] = local.value(points[q]);
+      if (compiled_value)
+        for (unsigned int q = 0; q < points.size(); ++q)
+          {
+            values[q] = compiled_value(points[q]);
+            checks.check(values[q], points[q], "value");
+          }
+      else
+        {
+          const ThreadParsers &local = parsers();
+          for (unsigned int q = 0; q < points.size(); ++q)
+            values[q] = local.value(points[q]);
+        }
     }
 
     Tensor<1, dim>
     gradient(const Point<dim> &p, const unsigned int = 0) const override
     {
-      return parsers().gradient(p);
+      if (!compiled_gradient)
+        return parsers().gradient(p);
+      const Tensor<1, dim> result = compiled_gradient(p);
+      checks.check(result, p);
+      return result;
     }
 
     void
@@ -316,26 +394,58 @@ namespace membranes
                   std::vector<Tensor<1, dim>>   &gradients,
                   const unsigned int = 0) const override
     {
-      const ThreadParsers &local = parsers();
-      for (unsigned int q = 0; q < points.size(); ++q)
-        gradients[q] = local.gradient(points[q]);
+      if (compiled_gradient)
+        for (unsigned int q = 0; q < points.size(); ++q)
+          {
+            gradients[q] = compiled_gradient(points[q]);
+            checks.check(gradients[q], points[q]);
+          }
+      else
+        {
+          const ThreadParsers &local = parsers();
+          for (unsigned int q = 0; q < points.size(); ++q)
+            gradients[q] = local.gradient(points[q]);
+        }
+    }
+
+    /**
+     * The gradient of the scene's gradient entry and the compiled one at
+     * @p p, when there are both (else nothing): the entry is then a check
+     * of the user's own derivatives.
+     */
+    std::optional<std::pair<Tensor<1, dim>, Tensor<1, dim>>>
+    gradient_entry_and_compiled(const Point<dim> &p) const
+    {
+      if (!compiled_gradient || Utilities::trim(gradient_expression).empty())
+        return {};
+      return std::pair{parsers().gradient(p), gradient(p)};
+    }
+
+    /** The InputError for the gradient entry, which should be @p allowed. */
+    Parameters::InputError
+    invalid_gradient(const std::string &allowed) const
+    {
+      return Parameters::invalid_entry(gradient_entry,
+                                       gradient_expression,
+                                       allowed);
     }
 
     /**
      * The step of the finite differences that give gradient(), on the
-     * calling thread.
+     * calling thread (without a compiled gradient).
      */
     void
     set_gradient_step(const double step) const
     {
-      parsers().step_size = step;
+      if (!compiled_gradient)
+        parsers().step_size = step;
     }
 
     /** The InputError for this entry, which should be @p allowed. */
     Parameters::InputError
     invalid(const std::string &allowed) const
     {
-      return parsers().function.invalid(allowed);
+      return checks.invalid(allowed);
     }
 
   private:
@@ -371,11 +481,7 @@ namespace membranes
             point = p;
             for (unsigned int d = 0; d < dim; ++d)
               gradient[d] = exact_gradient->evaluate(d);
-            static const char *const derivatives[] = {"derivative by x",
-                                                      "derivative by y",
-                                                      "derivative by z"};
-            for (unsigned int d = 0; d < dim; ++d)
-              exact_gradient->check(gradient[d], p, derivatives[d]);
+            exact_gradient->check(gradient, p);
             return gradient;
           }
         // The central differences of deal.II's AutoDerivativeFunction
@@ -412,11 +518,15 @@ namespace membranes
       return *local;
     }
 
+    const Entry<dim>                    checks;
     const std::string                   entry, expression;
     const std::map<std::string, double> constants;
     const std::string                   gradient_entry, gradient_expression;
     mutable Threads::ThreadLocalStorage<std::shared_ptr<ThreadParsers>>
       thread_parsers;
+
+    std::function<double(const Point<dim> &)>         compiled_value;
+    std::function<Tensor<1, dim>(const Point<dim> &)> compiled_gradient;
   };
 
 
@@ -446,32 +556,165 @@ namespace membranes
 
   template <int dim>
   ProblemData<dim>::ProblemData(const Parameters::Problem       &problem,
-                                const Parameters::ExactSolution &exact)
+                                const Parameters::ExactSolution &exact,
+                                const ConditionalOStream        &pcout)
     : mu{{problem.mu1, problem.mu2}}
     , mu_bar(problem.mu1 * problem.mu2 / (problem.mu1 + problem.mu2))
     , known(exact.known)
   {
     const auto constants = parse_constants(problem);
-    f[0] = std::make_unique<Expression>("Problem/f1", problem.f1, constants);
-    f[1] = std::make_unique<Expression>("Problem/f2", problem.f2, constants);
-    g    = std::make_unique<Expression>("Problem/g", problem.g, constants);
-    g2   = std::make_unique<Expression>("Problem/g2", problem.g2, constants);
-    g_and_g2 = std::make_unique<BoundaryValues>(*g, *g2);
-    if (known)
+    // The expressions of the scene, each parsed (a syntax error is an
+    // InputError here, with muparser's message, however they are then
+    // evaluated), and what compiling them asks for.
+    std::vector<std::pair<Expression *, CompiledFunctions::Request>> scene;
+    const auto add = [&](std::unique_ptr<Expression> &expression,
+                         const std::string           &entry,
+                         const std::string           &text,
+                         const bool                   gradient,
+                         const bool                   laplacian,
+                         const std::string           &gradient_entry = "",
+                         const std::string           &gradient_text  = "") {
+      expression = std::make_unique<Expression>(
+        entry, text, constants, gradient_entry, gradient_text);
+      scene.emplace_back(expression.get(),
+                         CompiledFunctions::Request{text, gradient, laplacian});
+    };
+    if (!exact.manufactured)
       {
-        exact_u[0]   = std::make_unique<Expression>("Exact solution/u1",
-                                                  exact.u1,
-                                                  constants,
-                                                  "Exact solution/u1 gradient",
-                                                  exact.u1_gradient);
-        exact_u[1]   = std::make_unique<Expression>("Exact solution/u2",
-                                                  exact.u2,
-                                                  constants,
-                                                  "Exact solution/u2 gradient",
-                                                  exact.u2_gradient);
-        exact_action = std::make_unique<Expression>("Exact solution/lambda",
-                                                    exact.lambda,
-                                                    constants);
+        add(f[0], "Problem/f1", problem.f1, false, false);
+        add(f[1], "Problem/f2", problem.f2, false, false);
+        add(g, "Problem/g", problem.g, false, false);
+        add(g2, "Problem/g2", problem.g2, false, false);
+      }
+    if (known || exact.manufactured)
+      {
+        const std::array<std::string, 2> u{{exact.u1, exact.u2}};
+        const std::array<std::string, 2> gradient{
+          {exact.u1_gradient, exact.u2_gradient}};
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            const std::string entry =
+              "Exact solution/u" + std::to_string(i + 1);
+            add(exact_u[i],
+                entry,
+                u[i],
+                true,
+                exact.manufactured,
+                entry + " gradient",
+                gradient[i]);
+          }
+        add(exact_action, "Exact solution/lambda", exact.lambda, false, false);
+      }
+
+    if (problem.expression_evaluation !=
+        Parameters::ExpressionEvaluation::parser)
+      try
+        {
+          compile(scene, constants);
+        }
+      catch (const CompiledFunctions::Unavailable &e)
+        {
+          if (exact.manufactured)
+            throw Parameters::invalid_entry("Exact solution/Manufactured data",
+                                            "true",
+                                            "needs compiled expressions, but " +
+                                              std::string(e.what()));
+          if (problem.expression_evaluation ==
+              Parameters::ExpressionEvaluation::compiled)
+            throw Parameters::invalid_entry(
+              "Problem/Expression evaluation",
+              "compiled",
+              "needs a working C++ compiler, but " + std::string(e.what()) +
+                "; or use auto or parser");
+          pcout << "Note: Problem/Expression evaluation = auto: " << e.what()
+                << "; the parser evaluates the expressions" << std::endl;
+        }
+    if (exact.manufactured)
+      manufacture(scene);
+    g_and_g2 = std::make_unique<BoundaryValues>(*g, *g2);
+  }
+
+
+
+  /**
+   * Compile the expressions of @p scene (with @p constants and those that
+   * muparser defines, _pi and _e) and evaluate them by the compiled code
+   * from now on, their gradients (where asked for) by its dual numbers.
+   */
+  template <int dim>
+  void
+  ProblemData<dim>::compile(
+    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
+                                        &scene,
+    const std::map<std::string, double> &constants)
+  {
+    std::map<std::string, double> all_constants = constants;
+    const mu::Parser              parser;
+    for (const auto &[name, value] : parser.GetConst())
+      all_constants.emplace(name, value);
+    std::vector<CompiledFunctions::Request> requests;
+    for (const auto &expression : scene)
+      requests.push_back(expression.second);
+    compiled = std::make_unique<CompiledFunctions>(requests,
+                                                   variable_names<dim>(),
+                                                   all_constants);
+    for (unsigned int i = 0; i < scene.size(); ++i)
+      {
+        const CompiledFunctions::Value value = compiled->value(i);
+        std::function<Tensor<1, dim>(const Point<dim> &)> gradient;
+        if (requests[i].gradient)
+          gradient = [derivatives =
+                        compiled->gradient(i)](const Point<dim> &p) {
+            Tensor<1, dim> result;
+            derivatives(&p[0], &result[0]);
+            return result;
+          };
+        scene[i].first->use_compiled(
+          [value](const Point<dim> &p) { return value(&p[0]); }, gradient);
+      }
+  }
+
+
+
+  /**
+   * The manufactured data (Exact solution/Manufactured data): from the
+   * compiled u1, u2 and λ of @p scene, f1 = −μ1Δu1 − λ, f2 = −μ2Δu2 + λ
+   * (Laplacians by the second-order dual numbers), g = u1 and g2 = u2.
+   */
+  template <int dim>
+  void
+  ProblemData<dim>::manufacture(
+    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
+      &scene)
+  {
+    const auto index = [&](const Expression *expression) {
+      return static_cast<unsigned int>(
+        std::find_if(scene.begin(),
+                     scene.end(),
+                     [&](const auto &e) { return e.first == expression; }) -
+        scene.begin());
+    };
+    const CompiledFunctions::Value lambda =
+      compiled->value(index(exact_action.get()));
+    const std::string entry = "Exact solution/Manufactured data";
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        const unsigned int             u         = index(exact_u[i].get());
+        const CompiledFunctions::Value laplacian = compiled->laplacian(u);
+        const CompiledFunctions::Value value     = compiled->value(u);
+        const double                   sign      = (i == 0 ? -1. : 1.);
+        const std::string              n         = std::to_string(i + 1);
+        f[i]                                     = std::make_unique<Expression>(
+          entry,
+          "f" + n + " = -mu" + n + " Laplace(u" + n + ") " +
+            (i == 0 ? "-" : "+") + " lambda",
+          [laplacian, lambda, sign, mu = mu[i]](const Point<dim> &p) {
+            return -mu * laplacian(&p[0]) + sign * lambda(&p[0]);
+          });
+        (i == 0 ? g : g2) = std::make_unique<Expression>(
+          "Exact solution/u" + n,
+          "g" + std::string(i == 0 ? "" : "2") + " = u" + n,
+          [value](const Point<dim> &p) { return value(&p[0]); });
       }
   }
 
@@ -559,6 +802,35 @@ namespace membranes
                   u->gradient(p);
                 }
               exact_lambda().value(p);
+              check_gradient_entries(p);
+            }
+        }
+  }
+
+
+
+  /**
+   * With compiled expressions the gradients of u1, u2 are those of their
+   * dual numbers; a gradient entry of the scene is then a check of the
+   * user's own derivatives: at @p p it must agree with them to 1e-8
+   * relative to the larger of the two, or to 1e-8 where both are below 1.
+   */
+  template <int dim>
+  void
+  ProblemData<dim>::check_gradient_entries(const Point<dim> &p) const
+  {
+    for (const auto &u : exact_u)
+      if (const auto both = u->gradient_entry_and_compiled(p))
+        {
+          const auto &[entry, derivative] = *both;
+          const double scale = std::max({1., entry.norm(), derivative.norm()});
+          if (!((entry - derivative).norm() <= 1e-8 * scale))
+            {
+              std::ostringstream allowed;
+              allowed << "at " << at(p) << " it is (" << entry
+                      << ") but the derivative of the exact solution is ("
+                      << derivative << ")";
+              throw u->invalid_gradient(allowed.str());
             }
         }
   }

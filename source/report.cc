@@ -54,7 +54,8 @@ namespace membranes
               r.flux_estimator_flux,
               r.flux_estimator_oscillation,
               r.flux_estimator_contact,
-              r.flux_estimator_boundary};
+              r.flux_estimator_boundary,
+              r.time_errors};
     }
 
     /** Columns that hold whole numbers. */
@@ -115,7 +116,8 @@ namespace membranes
                                                 "flux_estimator_flux",
                                                 "flux_estimator_oscillation",
                                                 "flux_estimator_contact",
-                                                "flux_estimator_boundary"};
+                                                "flux_estimator_boundary",
+                                                "time_errors_s"};
     return names;
   }
 

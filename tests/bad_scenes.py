@@ -44,6 +44,25 @@ CASES = [
     ("exact gradient with one expression",
      "subsection Exact solution\n  set Known = true\n"
      "  set u1 gradient = 2*x\nend\n", [], ["Exact solution/u1 gradient"]),
+    ("manufactured data with f1 set",
+     "subsection Problem\n  set f1 = 1\nend\n"
+     "subsection Exact solution\n  set Manufactured data = true\nend\n", [],
+     ["Problem/f1", "Manufactured data"]),
+    ("manufactured data with g2 set",
+     "subsection Problem\n  set g2 = -1\nend\n"
+     "subsection Exact solution\n  set Manufactured data = true\nend\n", [],
+     ["Problem/g2", "Manufactured data"]),
+    ("manufactured data with the parser",
+     "subsection Problem\n  set Expression evaluation = parser\nend\n"
+     "subsection Exact solution\n  set Manufactured data = true\nend\n", [],
+     ["Exact solution/Manufactured data", "parser"]),
+    ("unknown expression evaluation",
+     "subsection Problem\n  set Expression evaluation = jit\nend\n", [],
+     ["Problem/Expression evaluation", "auto", "compiled", "parser"]),
+    ("gradient entry that is not the derivative",
+     "subsection Exact solution\n  set Known = true\n  set u1 = x^2\n"
+     "  set u1 gradient = x; 0\nend\n", [],
+     ["Exact solution/u1 gradient", "derivative"]),
     ("bad function constants",
      "subsection Problem\n  set Function constants = R:0.5\nend\n", [],
      ["Problem/Function constants"]),
@@ -143,7 +162,8 @@ def check_good_command_lines(membranes):
     printed = run([membranes, "--print-parameters"])
     names = ["Domain", "Mesh file", "Cell type", "Initial refinement", "mu1",
              "mu2", "Function constants", "f1", "f2", "g", "g2", "Known",
-             "lambda", "u1 gradient", "u2 gradient", "Method",
+             "Expression evaluation", "lambda", "u1 gradient", "u2 gradient",
+             "Manufactured data", "Method",
              "Linear solver", "Tolerance", "Max active set iterations",
              "Stopping", "Balance fraction",
              "Strategy", "Cycles", "Marking",

@@ -37,8 +37,9 @@ namespace membranes
    * refine the last mesh (globally, or by the estimator's indicators), set
    * up DoFs and constraints, transfer the previous solution and active set to
    * the new mesh (nested iteration), solve, postprocess (λ_h, the discrete
-   * identities, errors), reconstruct the fluxes t_ih (if the scene asks for
-   * them), estimate the error, add a row to the report, write fields.
+   * identities), the errors against the exact solution, reconstruct the
+   * fluxes t_ih (if the scene asks for them), estimate the error, add a row
+   * to the report, write fields.
    *
    * Data layout is that of deal.II's step-40: a distributed triangulation
    * (make_triangulation(): p4est for quadrilaterals, serial for triangles),
@@ -82,6 +83,8 @@ namespace membranes
     compute_lambda_h();
     void
     postprocess();
+    void
+    compute_errors();
     bool
     computes_fluxes() const;
     void
@@ -106,7 +109,7 @@ namespace membranes
     ConditionalOStream     pcout;
     /**
      * The phases of a cycle: setup, assembly, solve, postprocess, estimate,
-     * flux; reset at the start of each cycle.
+     * flux, and the error norms (errors); reset at the start of each cycle.
      */
     TimerOutput computing_timer;
 

@@ -139,6 +139,14 @@ namespace membranes::Parameters
     parse_parameters(ParameterHandler &prm);
   };
 
+  /** How the expressions of a scene are evaluated. */
+  enum class ExpressionEvaluation
+  {
+    automatic, ///< Compiled when a compiler works, else the parser.
+    compiled,  ///< Compiled to machine code (CompiledFunctions).
+    parser     ///< Interpreted by muparser.
+  };
+
   /** Subsection `Problem`: tensions, loads and boundary heights of (1.1). */
   struct Problem
   {
@@ -150,6 +158,8 @@ namespace membranes::Parameters
     std::string f2;       ///< Load f2(x, y).
     std::string g;        ///< Height g ≥ 0 of membrane 1 on ∂ω.
     std::string g2;       ///< Height g2 ≤ g of membrane 2 on ∂ω.
+    /** Compiled expressions, the parser, or compiled if possible. */
+    ExpressionEvaluation expression_evaluation;
 
     static void
     declare_parameters(ParameterHandler &prm);
@@ -170,6 +180,11 @@ namespace membranes::Parameters
      */
     std::string u1_gradient;
     std::string u2_gradient; ///< ∇u2, likewise.
+    /**
+     * Derive the data from u1, u2, λ: f1 = −μ1Δu1 − λ, f2 = −μ2Δu2 + λ,
+     * g = u1 and g2 = u2 on ∂ω (Problem/f1, f2, g, g2 stay unset).
+     */
+    bool manufactured;
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -1,9 +1,11 @@
 #ifndef membranes_problem_data_h
 #define membranes_problem_data_h
 
+#include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/function.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/grid/tria.h>
+#include <membranes/compiled_function.h>
 #include <membranes/parameters.h>
 #include <memory>
 
@@ -19,27 +21,45 @@ namespace membranes
    * Every function is an expression in x, y in the syntax of deal.II's
    * FunctionParser, with the scene's `Function constants` and the names
    * `mu1`, `mu2`, `pi`, so that a manufactured solution written in terms of
-   * the tensions stays exact for any μ1, μ2. The expressions are evaluated
-   * by muparser directly, set up as FunctionParser sets it up (the same
-   * values to the last bit), one set of parsers per thread, looked up once
-   * per list of points (a cell's quadrature points), not, as
-   * FunctionParser does, on every evaluation. Expressions are parsed and
-   * evaluated once on construction; one that does not parse is an InputError
-   * naming its entry. Every value is checked where the program evaluates it:
-   * one that is not finite, or larger than Parameters::max_magnitude in
-   * magnitude, is an InputError naming the entry and the point.
+   * the tensions stays exact for any μ1, μ2. The expressions are compiled
+   * to machine code (CompiledFunctions) unless `Problem/Expression
+   * evaluation = parser`, or `auto` finds no working compiler; otherwise
+   * they are evaluated by muparser directly, set up as FunctionParser sets
+   * it up (the same values to the last bit), one set of parsers per thread,
+   * looked up once per list of points (a cell's quadrature points), not, as
+   * FunctionParser does, on every evaluation. Expressions are parsed by
+   * muparser and evaluated once on construction in either case; one that
+   * does not parse is an InputError naming its entry. Every value is
+   * checked where the program evaluates it: one that is not finite, or
+   * larger than Parameters::max_magnitude in magnitude, is an InputError
+   * naming the entry and the point.
    *
-   * The gradients of the exact displacements (for the H1 errors) are the
-   * scene's `Exact solution/u1 gradient` and `u2 gradient` when given (two
-   * expressions `∂/∂x; ∂/∂y`), otherwise central (second-order) finite
-   * differences of u1 and u2, with a step set by set_gradient_step().
+   * The gradients of the exact displacements (for the H1 errors) are, when
+   * compiled, those of forward-mode dual numbers (exact); the scene's
+   * `Exact solution/u1 gradient` and `u2 gradient` (two expressions
+   * `∂/∂x; ∂/∂y`), when given, are then checked against them. With the
+   * parser they are those entries when given, otherwise central
+   * (second-order) finite differences of u1 and u2, with a step set by
+   * set_gradient_step().
+   *
+   * With `Exact solution/Manufactured data` the loads are f1 = −μ1Δu1 − λ
+   * and f2 = −μ2Δu2 + λ, their Laplacians by second-order dual numbers,
+   * and g = u1, g2 = u2.
    */
   template <int dim>
   class ProblemData
   {
   public:
+    /**
+     * The data of the scene: its expressions parsed, and compiled unless
+     * `Problem/Expression evaluation = parser` (with `auto`, when no
+     * compiler works, a one-line note on @p pcout says so and the parser
+     * evaluates them). With `Exact solution/Manufactured data` the loads
+     * and boundary heights are derived from the exact solution.
+     */
     ProblemData(const Parameters::Problem       &problem,
-                const Parameters::ExactSolution &exact);
+                const Parameters::ExactSolution &exact,
+                const ConditionalOStream        &pcout);
 
     ~ProblemData();
 
@@ -112,6 +132,22 @@ namespace membranes
   private:
     class Expression;
     class BoundaryValues;
+
+    void
+    compile(
+      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
+                                          &scene,
+      const std::map<std::string, double> &constants);
+
+    void
+    manufacture(
+      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
+        &scene);
+
+    void
+    check_gradient_entries(const Point<dim> &p) const;
+
+    std::unique_ptr<CompiledFunctions> compiled;
 
     std::array<std::unique_ptr<Expression>, 2> f;
     std::unique_ptr<Expression>                g;

@@ -26,7 +26,10 @@ namespace membranes
     unsigned int            linear_iterations     = 0;
     /** Active vertices that are hanging nodes (0: the active set is on V_h). */
     unsigned int hanging_active_vertices = 0;
-    /** Wall time of the cycle's solve phases (not of output writing). */
+    /**
+     * Wall time of the cycle's phases of the method (not of output
+     * writing, nor of the error norms against the exact solution).
+     */
     double wall_time = 0;
     /** The same, summed over this and all previous cycles. */
     double cumulative_wall_time = 0;
@@ -34,6 +37,12 @@ namespace membranes
            time_postprocess = 0, time_estimate = 0;
     /** Flux reconstruction and flux estimator; empty when not computed. */
     std::optional<double> time_flux;
+    /**
+     * The error norms against the exact solution, a cost that a run
+     * without one never pays: not part of wall_time. Empty without an exact
+     * solution.
+     */
+    std::optional<double> time_errors;
 
     /** Errors; empty when the exact solution is not known. */
     std::optional<double> err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2,

@@ -1,0 +1,114 @@
+#ifndef membranes_compiled_function_h
+#define membranes_compiled_function_h
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace membranes
+{
+  /**
+   * The expressions of a scene as machine code. Each expression, in the
+   * grammar of muparser as deal.II's FunctionParser sets it up (operators
+   * `?:`, `||`, `&&`, `|`, `&`, comparisons, `+ - * / ^` and signs; the
+   * functions of muparser and those deal.II adds; the variables and the
+   * constants), is translated into a C++ function template of its variables,
+   * compiled into a shared object with the C++ compiler that built the
+   * program, and loaded with dlopen.
+   *
+   * The template is instantiated for double (the values), and for
+   * forward-mode dual numbers: one level for the gradient, two nested levels
+   * for the Laplacian (the sum of the second derivatives ∂²/∂x_d²), exact to
+   * round-off where the expression is differentiable, with no step size.
+   *
+   * The shared object is cached under cache_directory(), named by a hash of
+   * the generated source and of the compiler: a later run with the same
+   * expressions loads it without compiling. It is written under a temporary
+   * name and renamed, so that runs side by side (tests, MPI processes)
+   * never load a half-written file.
+   *
+   * The compiler is the one that built the program, or the command in the
+   * environment variable `MEMBRANES_CXX` when set.
+   */
+  class CompiledFunctions
+  {
+  public:
+    /**
+     * Why the expressions could not be compiled (no working compiler, a
+     * function such as rand() that has no compiled form, a cache directory
+     * that cannot be written): one line.
+     */
+    class Unavailable : public std::runtime_error
+    {
+    public:
+      using std::runtime_error::runtime_error;
+    };
+
+    /** One expression to compile, and whether its derivatives are needed. */
+    struct Request
+    {
+      std::string expression;
+      bool        gradient  = false;
+      bool        laplacian = false;
+    };
+
+    /** The value at the point p (its dim coordinates). */
+    using Value = double (*)(const double *p);
+    /** The dim derivatives at p, written to gradient. */
+    using Gradient = void (*)(const double *p, double *gradient);
+
+    /**
+     * Translate @p requests, expressions in the variables @p variables with
+     * the named @p constants (substituted by their values), and compile and
+     * load them (or load them from the cache). Throws Unavailable.
+     */
+    CompiledFunctions(const std::vector<Request>          &requests,
+                      const std::vector<std::string>      &variables,
+                      const std::map<std::string, double> &constants);
+
+    ~CompiledFunctions();
+
+    CompiledFunctions(const CompiledFunctions &) = delete;
+    CompiledFunctions &
+    operator=(const CompiledFunctions &) = delete;
+
+    /** The value of expression @p i. */
+    Value
+    value(const unsigned int i) const;
+
+    /** The gradient of expression @p i; only if requested. */
+    Gradient
+    gradient(const unsigned int i) const;
+
+    /** The Laplacian of expression @p i; only if requested. */
+    Value
+    laplacian(const unsigned int i) const;
+
+    /**
+     * Whether the shared object was compiled by this run (false: found in
+     * the cache), and the wall time that compiling or loading took.
+     */
+    bool   compiled_now = false;
+    double seconds      = 0;
+
+    /**
+     * The directory of the cached shared objects: `MEMBRANES_CACHE_DIR`,
+     * else `$XDG_CACHE_HOME/membranes`, else `$HOME/.cache/membranes`,
+     * the first that can be created and written; else a directory of this
+     * user in the system's temporary directory. Throws Unavailable if none
+     * can be.
+     */
+    static std::string
+    cache_directory();
+
+  private:
+    /** The symbol @p name of the loaded object; Unavailable if absent. */
+    void *
+    symbol(const std::string &name) const;
+
+    void *handle = nullptr;
+  };
+} // namespace membranes
+
+#endif
