@@ -1,6 +1,5 @@
 #!/usr/bin/env bash
-# Strong scaling of the quadrilateral path from one to two MPI processes
-# (SPEC §8).
+# Strong scaling of the quadrilateral path from one to two MPI processes.
 #
 #   benchmarks/mpi_scaling.sh [path/to/membranes] [output-dir]
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cost of the active set method against one linear solve (SPEC §7).
+# Cost of the active set method against one linear solve.
 #
 #   benchmarks/solver_cost.sh [path/to/membranes] [output-dir]
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Cost per cycle of the active set method against one linear solve (SPEC §7).
+"""Cost per cycle of the active set method against one linear solve.
 
 Usage::
 

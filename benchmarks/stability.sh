@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The stability suite of SPEC §6: stiff and extreme cases, one table.
+# The stability suite: stiff and extreme cases, one table.
 #
 #   benchmarks/stability.sh [path/to/membranes] [output-dir]
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The table of the stability suite (SPEC §6), from the runs of stability.sh.
+"""The table of the stability suite, from the runs of stability.sh.
 
 Usage::
 

@@ -15,7 +15,7 @@ namespace membranes
 
   /**
    * The linear problem of one active set iteration, solved on the sum and
-   * the difference of the membranes (`Solver/Method = decoupled`, SPEC §1).
+   * the difference of the membranes (`Solver/Method = decoupled`).
    *
    * <h3>The decoupling of the discrete problem</h3>
    * Let A be the stiffness matrix of the Laplacian on the scalar P1/Q1

@@ -22,7 +22,7 @@ namespace membranes
    * index when the exact solution is known.
    *
    * <h3>The residual estimator</h3>
-   * Per cell K (SPEC §2.3),
+   * Per cell K,
    *
    *   η_K² = Σ_i μ_i⁻¹ [ h_K² ‖f_ih + s_i λ_h + μ_i Δu_ih‖²_K
    *                     + ½ Σ_{e ⊂ ∂K \ ∂ω} h_e ‖[μ_i ∂_n u_ih]‖²_e

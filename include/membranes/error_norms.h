@@ -14,7 +14,7 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * Errors against a known exact solution (SPEC §3.3):
+   * Errors against a known exact solution:
    * |u_i − u_ih|_{H1(ω)}, ‖u_i − u_ih‖_{L2(ω)} for both membranes, and
    * ‖λ − λ_h‖_{L2(ω_h)}, where λ_h is piecewise constant on the dual cells
    * D_a and ω_h is their union (ω minus a strip along ∂ω).

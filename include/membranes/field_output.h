@@ -17,7 +17,7 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * Field output (SPEC §3.4), each file to a temporary name and renamed, so
+   * Field output, each file to a temporary name and renamed, so
    * that no half-written file is left:
    * - for ParaView (`Write vtu`), one VTU file per cycle with u1, u2,
    *   w = u1 − u2, λ_h (the nodal values λ_a), the active set indicator,

@@ -7,7 +7,7 @@
 
 /**
  * The run-time parameters of a scene. Each struct mirrors one subsection of
- * the parameter file (SPEC §3.2); `declare_parameters()` documents every
+ * the parameter file; `declare_parameters()` documents every
  * entry, `parse_parameters()` reads it into typed fields and rejects values
  * that the pattern cannot catch (e.g. a ratio of the tensions beyond
  * max_tension_ratio) with a one-line message naming the entry.
@@ -213,7 +213,7 @@ namespace membranes::Parameters
     balanced ///< At a fraction of the discretization error of the mesh.
   };
 
-  /** Subsection `Solver`: the primal-dual active set method (SPEC §2.2). */
+  /** Subsection `Solver`: the primal-dual active set method. */
   struct Solver
   {
     /** Coupled (u1, u2), decoupled (s, w), or the faster of the two. */

@@ -97,7 +97,7 @@ namespace membranes
 
 
   /**
-   * The report of a run (SPEC §3.3): report.csv with one row per cycle,
+   * The report of a run: report.csv with one row per cycle,
    * rewritten after every cycle (to a temporary name, then renamed, so that
    * a stopped run never leaves a half-written file), and at the end the
    * same numbers as a deal.II ConvergenceTable with observed rates in h
