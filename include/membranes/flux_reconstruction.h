@@ -12,9 +12,12 @@
 #include <deal.II/grid/reference_cell.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <map>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
 #include <membranes/dual_cell_quadrature.h>
+#include <membranes/flux_patch_problem.h>
+#include <membranes/flux_sub_triangles.h>
 #include <membranes/problem_data.h>
 #include <string>
 #include <vector>
@@ -25,8 +28,14 @@ namespace membranes
 
   /**
    * The objects of §4.2–4.3 of the paper on the current mesh: the dual mesh
-   * D_h, λ_h as a function on it, and the flux reconstructions
-   * t_ih ∈ RT0(S_h), i = 1, 2.
+   * D_h, λ_h as a function on it, the flux reconstructions
+   * t_ih ∈ RT0(S_h), i = 1, 2, of (4.13) with the identities (4.17), (4.18)
+   * and Lemma 17, and the equilibrated fluxes σ_ih of the flux estimator.
+   *
+   * The parts are in four files: the fluxes (4.13) and the identities in
+   * flux_reconstruction.cc, the patch equilibration in
+   * flux_equilibration.cc (with PatchProblem in flux_patch_problem.cc),
+   * the rotation relaxation in flux_rotations.cc.
    *
    * λ_h and the dual cells come from DiscreteAction, which holds λ_h
    * and the DualCellQuadrature on the pieces K ∩ D_a.
@@ -133,29 +142,24 @@ namespace membranes
    * rotation of the fluxes around p, and its coefficient is the one that
    * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
    * around p. Neither div σ_ih nor its normal continuity change, and the
-   * flux estimator only decreases (measured on P1: case M 1.087 → 1.042,
-   * the L-shape 1.28 → 1.20 on uniform meshes of 3·10⁴ DoFs). At an edge
+   * flux estimator only decreases. At an edge
    * with a hanging vertex c the stream function stays continuous on S_h:
    * c is the coarse side's m_e, and the midpoints of the two small edges
    * take half of the hat functions of their ends, which carries the
-   * corrections across (P1 adaptive: the straight free boundary
-   * 1.389 → 1.044, the disk 1.378 → 1.085). Vertices on ∂ω are left out:
+   * corrections across. Vertices on ∂ω are left out:
    * the normal flux there stays that of the patch problems. Last, inside
    * each cell, the curls of the quadratic edge bubbles of the edges of S_h
    * through b_K (relax_cell_rotations()) follow the bilinear part of a Q1
    * gradient, which no RT0 field of the sub-triangles does.
    *
-   * On each cell the sub-triangles form a ring around b_K; with the
-   * fluxes through their half-edges and one circulation per cell, the
-   * divergence constraints inside the cell are solved in closed form, so a
-   * patch problem is a small saddle point system: 15 (Q1) to 23 (P1)
-   * unknowns around a regular interior vertex.
+   * Each patch problem is a PatchProblem; the sub-triangles and their
+   * Raviart–Thomas basis are a SubTriangleBasis.
    *
    * On several processes the support of a condensed φ_a can reach beyond
    * the ghost layer of a process that owns one of its cells. Each process
    * therefore writes, for its owned cells, what the patch problems need
-   * into records of plain numbers (with the half-edges named by the global
-   * DoF indices of their end vertices, the same on every process), sends them
+   * into PatchRecords (with the half-edges named by the global DoF indices
+   * of their end vertices, the same on every process), sends them
    * to the owner of a, which solves the patch problem and sends σ_ih^a back
    * (Utilities::MPI::some_to_some).
    *
@@ -267,6 +271,10 @@ namespace membranes
      */
     using EdgeKey = std::array<types::global_dof_index, 2>;
 
+    /** The coefficients of a condensed φ_a in the hat functions of a cell. */
+    using HatCoefficients =
+      std::array<double, GeometryInfo<dim>::vertices_per_cell>;
+
     /**
      * What the reconstruction keeps of one sub-triangle κ. The type is
      * trivial: the arrays of all sub-triangles are allocated without
@@ -325,27 +333,120 @@ namespace membranes
       bool    on_boundary;
     };
 
-    /** t̂ at the reference point @p x of sub-triangle @p s with @p fluxes. */
-    Tensor<1, dim>
-    reference_flux(const unsigned int           s,
-                   const std::array<double, 3> &fluxes,
-                   const Point<dim>            &x) const;
+    /** @name The fluxes t_ih of (4.13) (flux_reconstruction.cc) */
+    /** @{ */
+
+    /** The work arrays of one thread of compute_local_fluxes(). */
+    struct LocalFluxScratch;
+    /** What one cell gives the minimization of the half-edge fluxes. */
+    struct LocalFluxCopy;
+    /** The unknown half-edge fluxes of the minimization and their sums. */
+    struct HalfEdgeMinimization;
 
     /**
-     * The curl of the edge bubble 4 λ_p λ_q of edge @p l of sub-triangle
-     * @p s (p, q its ends, λ the barycentric coordinates of the reference
-     * sub-triangle) at the reference point @p x.
+     * On the owned and ghost cells the fluxes (4.13) through the edges of
+     * the sub-triangles inside the cells, the inner products of the
+     * minimization and, on the owned cells, the @p patch_terms; the sums of
+     * the minimization of the half-edge fluxes are returned.
      */
-    Tensor<1, dim>
-    reference_rotation(const unsigned int s,
-                       const unsigned int l,
-                       const Point<dim>  &x) const;
+    HalfEdgeMinimization
+    compute_local_fluxes(const VectorType          &ghosted_solution,
+                         AlignedVector<PatchTerms> &patch_terms);
+
+    /** The worker of compute_local_fluxes() on @p cell. */
+    void
+    local_fluxes_on_cell(const CellIterator        &cell,
+                         const VectorType          &ghosted_solution,
+                         AlignedVector<PatchTerms> &patch_terms,
+                         LocalFluxScratch          &scratch,
+                         LocalFluxCopy             &copy);
+
+    /**
+     * The fluxes (4.13) through the edges 0 and 1 of sub-triangle @p s of
+     * the cell of @p scratch and, on an owned cell, the flux densities of
+     * μ_i ∇u_ih through all three edges for the patch problems.
+     */
+    void
+    integrate_edge_fluxes(const CellIterator     &cell,
+                          const unsigned int      s,
+                          const LocalFluxScratch &scratch,
+                          SubTriangleData        &kappa,
+                          PatchTerms             &terms) const;
+
+    /**
+     * The Gram matrices, the products with μ_i ∇u_ih, the area, ∫ f_i and
+     * (on an owned cell) the hat function terms on sub-triangle @p s.
+     */
+    void
+    integrate_sub_triangle(const CellIterator     &cell,
+                           const unsigned int      s,
+                           const LocalFluxScratch &scratch,
+                           SubTriangleData        &kappa,
+                           PatchTerms             &terms) const;
+
+    /**
+     * The unknowns of the half-edge a–m_e of sub-triangle @p s: in the
+     * minimization of t_ih written to @p copy, in the patch problems to
+     * @p terms (on an owned cell).
+     */
+    void
+    name_half_edge(const CellIterator &cell,
+                   const unsigned int  s,
+                   PatchTerms         &terms,
+                   LocalFluxCopy      &copy) const;
+
+    /** The copier of compute_local_fluxes(): sums of the minimization. */
+    void
+    add_to_minimization(const LocalFluxCopy  &copy,
+                        HalfEdgeMinimization &minimization) const;
+
+    /** The minimizers: the fluxes of t_ih through the half-edges. */
+    void
+    set_half_edge_fluxes(const HalfEdgeMinimization &minimization);
+
+    /** @} */
+
+    /** @name The patch equilibration (flux_equilibration.cc) */
+    /** @{ */
+
+    /**
+     * A cell K in the support of the condensed hat function φ_a, with the
+     * coefficients of φ_a in the hat functions of K's vertices (1 at a, the
+     * constraint weight at a hanging vertex with parent a).
+     */
+    struct PatchMember
+    {
+      types::global_dof_index a;
+      CellIterator            cell;
+      HatCoefficients         coefficients;
+    };
+
+    /**
+     * The records exchanged with other processes: the cells whose records
+     * went to each process, the records received from each process, by the
+     * vertex a the records of its patch (process, record of a cell), and
+     * the buffers of the answers, σ_ih^a on the received sub-triangles.
+     */
+    struct RemotePatches
+    {
+      std::map<unsigned int, std::vector<CellIterator>> sent;
+      std::map<unsigned int, std::vector<PatchRecord>>  received;
+      std::map<types::global_dof_index,
+               std::vector<std::pair<unsigned int, unsigned int>>>
+                                                  members;
+      std::map<unsigned int, std::vector<double>> replies;
+    };
+
+    /** The work arrays of one thread of solve_patches(). */
+    struct PatchScratch;
+    /** σ_ih^a of one patch on its owned cells. */
+    struct PatchCopy;
 
     /**
      * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch
      * problems on the supports of the condensed hat functions φ_a (see the
      * class comment), each solved by the owner of a on the records of its
-     * cells, with @p patch_terms from reconstruct().
+     * cells, with @p patch_terms from reconstruct(); then the rotations.
      */
     void
     equilibrate(const AlignedVector<PatchTerms> &patch_terms,
@@ -354,29 +455,70 @@ namespace membranes
                 const MPI_Comm                   mpi_communicator);
 
     /**
-     * Write the record of the sub-triangles of @p cell (in the order of
-     * ring) for the patch problem of the condensed hat function with
-     * @p coefficients on @p cell to @p record.
+     * The members of the patches of the owned cells, in the order of the
+     * cells and, on each cell, by increasing a.
+     */
+    std::vector<PatchMember>
+    patch_members(
+      const AffineConstraints<double> &hanging_node_constraints) const;
+
+    /**
+     * Send the records of @p remote_members to the owners of their a and
+     * receive the records of the patches of the owned vertices.
+     */
+    RemotePatches
+    send_patch_records(const std::vector<PatchMember>  &remote_members,
+                       const AlignedVector<PatchTerms> &patch_terms,
+                       const IndexSet                  &locally_owned_dofs,
+                       const MPI_Comm                   mpi_communicator) const;
+
+    /**
+     * The patch problems of the owned vertices, on threads, with the
+     * members @p local_members (sorted by a) and the records of @p remote;
+     * adds σ_ih^a on the owned cells, writes it to the replies of @p remote
+     * on the others.
+     */
+    void
+    solve_patches(const std::vector<PatchMember>  &local_members,
+                  const AlignedVector<PatchTerms> &patch_terms,
+                  RemotePatches                   &remote);
+
+    /**
+     * The worker of solve_patches(): the patch problem of the members
+     * local_members[first, end), which share their a.
+     */
+    void
+    solve_patch(const unsigned int               first,
+                const unsigned int               end,
+                const std::vector<PatchMember>  &local_members,
+                const AlignedVector<PatchTerms> &patch_terms,
+                RemotePatches                   &remote,
+                PatchScratch                    &scratch,
+                PatchCopy                       &copy) const;
+
+    /**
+     * Write the records of the sub-triangles of @p cell (in the order of
+     * the ring) for the patch problem of the condensed hat function φ_a
+     * with @p coefficients on @p cell to @p record.
      */
     void
     write_patch_record(const CellIterator              &cell,
-                       const std::array<double, 4>     &coefficients,
+                       const types::global_dof_index    a,
+                       const HatCoefficients           &coefficients,
                        const AlignedVector<PatchTerms> &patch_terms,
-                       double                          *record) const;
+                       PatchRecord                     *record) const;
 
-    /**
-     * The patch problem of vertex @p a on the records @p patch of the
-     * cells of the support of φ_a: writes the fluxes of σ_ih^a through the
-     * three edges of each sub-triangle, per i, to @p result; @p scratch
-     * holds work arrays from one call to the next.
-     */
-    struct PatchScratch;
-
+    /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
     void
-    solve_patch_problem(const types::global_dof_index      a,
-                        const std::vector<const double *> &patch,
-                        const std::vector<double *>       &result,
-                        PatchScratch                      &scratch) const;
+    add_patch_result(const CellIterator &cell, const double *result);
+
+    /** @} */
+
+    /** @name The rotation relaxation (flux_rotations.cc) */
+    /** @{ */
+
+    /** The rotations around the vertices of S_h (see the .cc file). */
+    struct Rotations;
 
     /**
      * Divergence-free corrections of σ_ih on the locally owned cells: the
@@ -386,6 +528,18 @@ namespace membranes
      */
     void
     relax_rotations();
+
+    /**
+     * The rotations around the vertices p of S_h not on ∂ω that an owned
+     * cell touches, grouped by the kind of p.
+     */
+    Rotations
+    rotations_around_vertices() const;
+
+    /** σ_ih of the owned cells in @p sigma to the ghost cells. */
+    void
+    exchange_to_ghosts(
+      std::vector<std::array<std::array<double, 3>, 2>> &sigma) const;
 
     /** Sweeps of relax_rotations(). */
     static constexpr unsigned int rotation_sweeps = 3;
@@ -399,36 +553,40 @@ namespace membranes
     void
     relax_cell_rotations();
 
-    /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
-    void
-    add_patch_result(const CellIterator &cell, const double *result);
+    /** @} */
+
+    /** @name The identities (flux_reconstruction.cc) */
+    /** @{ */
+
+    /**
+     * Per vertex a, condensed with the hanging node constraints: meas(D_a),
+     * ∫_{D_a} div t_ih, f_ih meas(D_a) and f_ih ∫ φ_a (per i at the DoF of
+     * membrane i).
+     */
+    struct DualCellSums
+    {
+      VectorType measure, divergence, load_on_pieces, load_on_hats;
+    };
+
+    /** The DualCellSums of the locally owned cells. */
+    DualCellSums
+    dual_cell_sums(const AffineConstraints<double> &hanging_node_constraints,
+                   const IndexSet                  &locally_owned_dofs,
+                   const MPI_Comm                   mpi_communicator) const;
+
+    /** @} */
 
     const Discretization<dim>     &discretization;
     const ProblemData<dim>        &data;
     const DiscreteAction<dim>     &action;
     const DualCellQuadrature<dim> &dual_cell_quadrature;
+    /** The sub-triangles and their Raviart–Thomas basis. */
+    const SubTriangleBasis<dim> basis;
 
     SmartPointer<const DoFHandler<dim>> dof_handler;
 
     /** By active cell index × sub-triangles per cell + sub-triangle. */
     AlignedVector<SubTriangleData> sub_triangle_data;
-    /**
-     * The sub-triangles of a cell in the order of the ring they form
-     * around b_K: ring[j] and ring[j+1] share edge 0 (m_e–b_K) of ring[j]
-     * for even j, edge 1 (a–b_K) for odd j; the last closes the ring.
-     */
-    std::vector<unsigned int> ring;
-    /**
-     * The hat function of vertex v at Gauss point k of edge e of
-     * sub-triangle s, at ((s · 3 + e) · 2 + k) · 4 + v.
-     */
-    std::vector<double> edge_shape_values;
-
-    /**
-     * reference_rotation() of the edges 0 and 1 of the sub-triangle of each
-     * point of the dual quadrature, at that point.
-     */
-    std::vector<std::array<Tensor<1, dim>, 2>> rotation_basis;
     /** f_1, f_2 at the points of the dual quadrature, cell by cell. */
     AlignedVector<double> load_at_points;
     /** ∫_K φ_v for the vertices v of each locally owned cell K. */
