@@ -66,8 +66,8 @@ namespace membranes
 
   /**
    * The local problem of the patch equilibration of FluxReconstruction on
-   * the support ω_a of a condensed hat function φ_a: the field σ_ih^a ∈
-   * RT0(S_h) on ω_a with
+   * the support ω_a of a condensed hat function φ_a: the field σ_ih^a in
+   * the Raviart–Thomas space Z_h of (4.12) on ω_a with
    *
    *   ∫_κ div σ_ih^a = ∫_κ r_ia,  r_ia = (f_i + s_i λ_a) φ_a
    *                                      − μ_i ∇u_ih·∇φ_a,
@@ -75,7 +75,9 @@ namespace membranes
    * on every sub-triangle κ, zero normal flux on ∂ω_a inside ω and the
    * prescribed normal flux on ∂ω, closest in the L² norm of the Gram
    * matrices of the sub-triangles to the RT0 field T_ia with the fluxes of
-   * −μ_i φ_a ∇u_ih (see the class comment of FluxReconstruction).
+   * −μ_i φ_a ∇u_ih (see the class comment of FluxReconstruction). Around an
+   * interior vertex the problem is solvable because ∫ r_ia = 0 is (4.5) for
+   * the condensed φ_a.
    *
    * On each cell the sub-triangles form a ring around b_K; with the fluxes
    * through their half-edges and one circulation per cell, the divergence

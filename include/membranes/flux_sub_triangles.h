@@ -69,8 +69,8 @@ namespace membranes
   /**
    * The sub-triangles κ = (a, m_e, b_K) of the reference cell, on which the
    * dual mesh D_h of §4.2 of the paper and the sub-mesh S_h are built, and
-   * the lowest order Raviart–Thomas basis on them in which the fluxes
-   * t_ih of (4.13) and σ_ih are written.
+   * the basis of the lowest order Raviart–Thomas space Z_h of (4.12) on
+   * them, in which the fluxes t_ih of (4.13) and σ_ih are written.
    *
    * On a reference sub-triangle with corners p_0, p_1, p_2 the basis
    * function of unit outward flux through the edge opposite p_j is
