@@ -28,9 +28,10 @@ namespace membranes
 
   /**
    * The objects of §4.2–4.3 of the paper on the current mesh: the dual mesh
-   * D_h, λ_h as a function on it, the flux reconstructions
-   * t_ih ∈ RT0(S_h), i = 1, 2, of (4.13) with the identities (4.17), (4.18)
-   * and Lemma 17, and the equilibrated fluxes σ_ih of the flux estimator.
+   * D_h, λ_h as a function on it, the flux reconstructions t_ih,
+   * i = 1, 2, of (4.13) in the Raviart–Thomas space Z_h = RT0(S_h) of
+   * (4.12) with the identities (4.17), (4.18) and Lemma 17, and the
+   * equilibrated fluxes σ_ih ∈ Z_h of the flux estimator.
    *
    * The parts are in four files: the fluxes (4.13) and the identities in
    * flux_reconstruction.cc, the patch equilibration in
@@ -142,12 +143,12 @@ namespace membranes
    * rotation of the fluxes around p, and its coefficient is the one that
    * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
    * around p. Neither div σ_ih nor its normal continuity change, and the
-   * flux estimator only decreases. At an edge
-   * with a hanging vertex c the stream function stays continuous on S_h:
-   * c is the coarse side's m_e, and the midpoints of the two small edges
-   * take half of the hat functions of their ends, which carries the
-   * corrections across. Vertices on ∂ω are left out:
-   * the normal flux there stays that of the patch problems. Last, inside
+   * flux estimator only decreases. At an edge with a hanging vertex c the
+   * stream function stays continuous on S_h: c is the coarse side's m_e,
+   * and the midpoints of the two small edges take half of the hat
+   * functions of their ends, which carries the corrections across.
+   * Vertices on ∂ω are left out: the normal flux there stays that of the
+   * patch problems. Last, inside
    * each cell, the curls of the quadratic edge bubbles of the edges of S_h
    * through b_K (relax_cell_rotations()) follow the bilinear part of a Q1
    * gradient, which no RT0 field of the sub-triangles does.
