@@ -15,12 +15,11 @@
 #include <sstream>
 #include <vector>
 
-/**
- * @file The scene file as deal.II's ParameterHandler reads it, and the
- * program's own part of reading it: the guard against include cycles, and
- * error lines that say where an error is in the terms of the scene
- * (`Subsection/Entry`, the declared alternatives) instead of deal.II's.
- */
+// Reading a scene: deal.II's ParameterHandler parses it; the program's own
+// part is the guard against include cycles and error lines that say where
+// an error is in the terms of the scene (`Subsection/Entry`, the declared
+// alternatives) instead of deal.II's; and the --set assignments and the
+// record of the parameters (parameters.prm).
 namespace membranes::Parameters
 {
   using dealii::Utilities::trim;
