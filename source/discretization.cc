@@ -249,6 +249,111 @@ namespace membranes
 
 
 
+  namespace
+  {
+    /**
+     * The coarse mesh of @p geometry's domain in @p coarse: as deal.II
+     * makes it (quadrilaterals) or as the mesh file has it.
+     */
+    template <int dim>
+    void
+    make_coarse_mesh(const Parameters::Geometry &geometry,
+                     Triangulation<dim>         &coarse)
+    {
+      switch (geometry.domain)
+        {
+          case Parameters::Domain::square:
+            GridGenerator::hyper_cube(coarse, -1, 1);
+            break;
+          case Parameters::Domain::lshape:
+            GridGenerator::hyper_L(coarse, -1, 1);
+            break;
+          case Parameters::Domain::slit:
+            // deal.II's slit runs from the bottom edge (0,-1) to the centre;
+            // the quarter turn (x, y) -> (-y, x), exact in floating point,
+            // puts it on [0,1) x {0}. Its four cells do not share the
+            // vertices along the slit: each face of the slit has its own, so
+            // both are boundary.
+            GridGenerator::hyper_cube_slit(coarse, -1, 1);
+            GridTools::transform(
+              [](const Point<dim> &p) { return Point<dim>(-p[1], p[0]); },
+              coarse);
+            break;
+          case Parameters::Domain::disk:
+            GridGenerator::hyper_ball(coarse);
+            break;
+          case Parameters::Domain::file:
+            read_mesh_file(geometry.mesh_file, coarse);
+            break;
+        }
+    }
+
+
+
+    /**
+     * Keep the disk split into triangles, @p triangulation, on its circle:
+     * the vertices on its boundary (after a refinement, the new ones in the
+     * middle of chords) are moved onto the unit circle, where a spherical
+     * manifold on the boundary faces would put them. Such a manifold cannot
+     * be used: MappingFE, the mapping of simplices, requires a cell and all
+     * its faces to share one manifold id (a Debug build stops on it), so the
+     * manifolds that the split copied from the disk of quadrilaterals are
+     * removed too.
+     */
+    template <int dim>
+    void
+    keep_on_circle(Triangulation<dim> &triangulation)
+    {
+      for (const auto &cell : triangulation.active_cell_iterators())
+        cell->set_all_manifold_ids(numbers::flat_manifold_id);
+      triangulation.reset_all_manifolds();
+      const auto onto_circle = [&triangulation]() {
+        for (const auto &face : triangulation.active_face_iterators())
+          if (face->at_boundary())
+            for (const unsigned int v : face->vertex_indices())
+              face->vertex(v) /= face->vertex(v).norm();
+      };
+      onto_circle();
+      triangulation.signals.post_refinement.connect(onto_circle);
+    }
+
+
+
+    /**
+     * Each refinement makes four cells of one: refuse a first mesh that
+     * would not fit in memory (@p triangulation refined by @p geometry's
+     * initial refinement) before trying to build it.
+     */
+    template <int dim>
+    void
+    check_initial_refinement(const Parameters::Geometry &geometry,
+                             const Triangulation<dim>   &triangulation)
+    {
+      const std::uint64_t max_cells = 1 << 22;
+      const double        cells     = triangulation.n_global_active_cells() *
+                           std::pow(GeometryInfo<dim>::max_children_per_cell,
+                                    geometry.initial_refinement);
+      if (cells > max_cells)
+        {
+          std::ostringstream allowed;
+          allowed << "the first mesh would have "
+                  << static_cast<std::uint64_t>(cells) << " cells ("
+                  << triangulation.n_global_active_cells()
+                  << " coarse cells, each "
+                  << "refined into " << GeometryInfo<dim>::max_children_per_cell
+                  << "^" << geometry.initial_refinement << "); at most "
+                  << max_cells
+                  << " are allowed, finer meshes come from the cycles";
+          throw Parameters::invalid_entry("Geometry/Initial refinement",
+                                          std::to_string(
+                                            geometry.initial_refinement),
+                                          allowed.str());
+        }
+    }
+  } // namespace
+
+
+
   template <int dim>
   void
   create_mesh(const Parameters::Geometry &geometry,
@@ -257,8 +362,7 @@ namespace membranes
     const bool want_triangles =
       (geometry.cell_type == Parameters::CellType::triangle);
 
-    // The coarse mesh, as deal.II makes it (quadrilaterals) or as the file
-    // has it. It is built in place unless it has to be split into
+    // The coarse mesh is built in place unless it has to be split into
     // triangles, so that manifolds tied to it (the disk's transfinite
     // interior) stay valid; a file is read into a serial triangulation
     // first, because it may hold triangles, which p4est cannot take, and
@@ -268,32 +372,7 @@ namespace membranes
     Triangulation<dim>  serial_coarse;
     Triangulation<dim> &coarse =
       (want_triangles || serial_first) ? serial_coarse : triangulation;
-    switch (geometry.domain)
-      {
-        case Parameters::Domain::square:
-          GridGenerator::hyper_cube(coarse, -1, 1);
-          break;
-        case Parameters::Domain::lshape:
-          GridGenerator::hyper_L(coarse, -1, 1);
-          break;
-        case Parameters::Domain::slit:
-          // deal.II's slit runs from the bottom edge (0,-1) to the centre;
-          // the quarter turn (x, y) -> (-y, x), exact in floating point,
-          // puts it on [0,1) x {0}. Its four cells do not share the
-          // vertices along the slit: each face of the slit has its own, so
-          // both are boundary.
-          GridGenerator::hyper_cube_slit(coarse, -1, 1);
-          GridTools::transform(
-            [](const Point<dim> &p) { return Point<dim>(-p[1], p[0]); },
-            coarse);
-          break;
-        case Parameters::Domain::disk:
-          GridGenerator::hyper_ball(coarse);
-          break;
-        case Parameters::Domain::file:
-          read_mesh_file(geometry.mesh_file, coarse);
-          break;
-      }
+    make_coarse_mesh(geometry, coarse);
 
     const auto &cell_types = coarse.get_reference_cells();
     if (cell_types.size() != 1)
@@ -316,52 +395,11 @@ namespace membranes
         else
           GridGenerator::convert_hypercube_to_simplex_mesh(serial_coarse,
                                                            triangulation);
-        // The split disk keeps its circle: the vertices on its boundary
-        // (after a refinement, the new ones in the middle of chords) are
-        // moved onto the unit circle, where a spherical manifold on the
-        // boundary faces would put them. Such a manifold cannot be used:
-        // MappingFE, the mapping of simplices, requires a cell and all its
-        // faces to share one manifold id (a Debug build stops on it), so
-        // the manifolds that the split copied from the disk of
-        // quadrilaterals are removed too.
         if (geometry.domain == Parameters::Domain::disk)
-          {
-            for (const auto &cell : triangulation.active_cell_iterators())
-              cell->set_all_manifold_ids(numbers::flat_manifold_id);
-            triangulation.reset_all_manifolds();
-            const auto onto_circle = [&triangulation]() {
-              for (const auto &face : triangulation.active_face_iterators())
-                if (face->at_boundary())
-                  for (const unsigned int v : face->vertex_indices())
-                    face->vertex(v) /= face->vertex(v).norm();
-            };
-            onto_circle();
-            triangulation.signals.post_refinement.connect(onto_circle);
-          }
+          keep_on_circle(triangulation);
       }
 
-    // Each refinement makes four cells of one: refuse a first mesh that
-    // would not fit in memory before trying to build it.
-    const std::uint64_t max_cells = 1 << 22;
-    const double        cells     = triangulation.n_global_active_cells() *
-                         std::pow(GeometryInfo<dim>::max_children_per_cell,
-                                  geometry.initial_refinement);
-    if (cells > max_cells)
-      {
-        std::ostringstream allowed;
-        allowed << "the first mesh would have "
-                << static_cast<std::uint64_t>(cells) << " cells ("
-                << triangulation.n_global_active_cells()
-                << " coarse cells, each "
-                << "refined into " << GeometryInfo<dim>::max_children_per_cell
-                << "^" << geometry.initial_refinement << "); at most "
-                << max_cells
-                << " are allowed, finer meshes come from the cycles";
-        throw Parameters::invalid_entry("Geometry/Initial refinement",
-                                        std::to_string(
-                                          geometry.initial_refinement),
-                                        allowed.str());
-      }
+    check_initial_refinement(geometry, triangulation);
     triangulation.refine_global(geometry.initial_refinement);
   }
 

@@ -81,6 +81,93 @@ namespace
       return MultithreadInfo::n_cores();
     return std::max(CPU_COUNT(&cpus), 1);
   }
+
+
+
+  /** What the command line asks for. */
+  struct Arguments
+  {
+    bool                     help             = false;
+    bool                     print_parameters = false;
+    std::vector<std::string> assignments;
+    std::string              scene;
+  };
+
+  /**
+   * The options and the scene file of @p argv; an InputError for an
+   * unknown option, a missing scene or a second one.
+   */
+  Arguments
+  read_arguments(const int argc, char **argv)
+  {
+    Arguments arguments;
+    for (int i = 1; i < argc; ++i)
+      {
+        const std::string arg = argv[i];
+        if (arg == "-h" || arg == "--help")
+          {
+            arguments.help = true;
+            return arguments;
+          }
+        else if (arg == "-p" || arg == "--print-parameters")
+          {
+            arguments.print_parameters = true;
+            return arguments;
+          }
+        else if (arg == "-s" || arg == "--set")
+          {
+            if (i + 1 == argc)
+              throw membranes::Parameters::InputError(arg +
+                                                      " needs an argument");
+            arguments.assignments.push_back(argv[++i]);
+          }
+        else if (!arg.empty() && arg[0] == '-')
+          throw membranes::Parameters::InputError("unknown option '" + arg +
+                                                  "' (see --help)");
+        else if (arguments.scene.empty())
+          arguments.scene = arg;
+        else
+          throw membranes::Parameters::InputError(
+            "more than one scene file given ('" + arguments.scene + "', '" +
+            arg + "')");
+      }
+    if (arguments.scene.empty())
+      throw membranes::Parameters::InputError(
+        "no scene file given (see --help)");
+    return arguments;
+  }
+
+
+
+  /**
+   * The parameters of the scene of @p arguments with its --set assignments
+   * applied, read into @p prm and parsed. A relative mesh file is found
+   * next to the scene that names it; @p prm, the record of the parameters,
+   * names it by its absolute path, to be found from the output directory
+   * too.
+   */
+  membranes::Parameters::All
+  read_parameters(ParameterHandler &prm, const Arguments &arguments)
+  {
+    namespace Parameters = membranes::Parameters;
+    Parameters::read_scene(prm, arguments.scene);
+    for (const auto &assignment : arguments.assignments)
+      Parameters::set_entry(prm, assignment);
+
+    Parameters::All parameters;
+    parameters.parse_parameters(prm);
+    auto &mesh_file = parameters.geometry.mesh_file;
+    if (!mesh_file.empty() && std::filesystem::path(mesh_file).is_relative())
+      {
+        mesh_file =
+          (std::filesystem::path(arguments.scene).parent_path() / mesh_file)
+            .string();
+        Parameters::set_entry(prm,
+                              "Geometry/Mesh file=" +
+                                std::filesystem::absolute(mesh_file).string());
+      }
+    return parameters;
+  }
 } // namespace
 
 
@@ -117,61 +204,16 @@ main(int argc, char **argv)
     {
       ParameterHandler prm;
       Parameters::All::declare_parameters(prm);
-
-      std::vector<std::string> assignments;
-      std::string              scene;
-      for (int i = 1; i < argc; ++i)
+      const Arguments arguments = read_arguments(argc, argv);
+      if (arguments.help || arguments.print_parameters)
         {
-          const std::string arg = argv[i];
-          if (arg == "-h" || arg == "--help")
-            {
-              if (first_process)
-                std::cout << usage;
-              return 0;
-            }
-          else if (arg == "-p" || arg == "--print-parameters")
-            {
-              if (first_process)
-                prm.print_parameters(std::cout, ParameterHandler::PRM);
-              return 0;
-            }
-          else if (arg == "-s" || arg == "--set")
-            {
-              if (i + 1 == argc)
-                throw Parameters::InputError(arg + " needs an argument");
-              assignments.push_back(argv[++i]);
-            }
-          else if (!arg.empty() && arg[0] == '-')
-            throw Parameters::InputError("unknown option '" + arg +
-                                         "' (see --help)");
-          else if (scene.empty())
-            scene = arg;
-          else
-            throw Parameters::InputError("more than one scene file given ('" +
-                                         scene + "', '" + arg + "')");
+          if (first_process && arguments.help)
+            std::cout << usage;
+          if (first_process && arguments.print_parameters)
+            prm.print_parameters(std::cout, ParameterHandler::PRM);
+          return 0;
         }
-      if (scene.empty())
-        throw Parameters::InputError("no scene file given (see --help)");
-
-      Parameters::read_scene(prm, scene);
-      for (const auto &assignment : assignments)
-        Parameters::set_entry(prm, assignment);
-
-      Parameters::All parameters;
-      parameters.parse_parameters(prm);
-      // A relative mesh file is found next to the scene that names it; the
-      // record of the parameters names it by its absolute path, to be
-      // found from the output directory too.
-      auto &mesh_file = parameters.geometry.mesh_file;
-      if (!mesh_file.empty() && std::filesystem::path(mesh_file).is_relative())
-        {
-          mesh_file =
-            (std::filesystem::path(scene).parent_path() / mesh_file).string();
-          Parameters::set_entry(
-            prm,
-            "Geometry/Mesh file=" +
-              std::filesystem::absolute(mesh_file).string());
-        }
+      const Parameters::All parameters = read_parameters(prm, arguments);
 
       MembraneProblem<2> problem(parameters,
                                  {Parameters::parameter_file(prm),

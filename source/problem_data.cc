@@ -2,12 +2,12 @@
 #include <cctype>
 #include <cmath>
 #include <deal.II/base/function_parser.h>
-#include <deal.II/base/mu_parser_internal.h>
 #include <deal.II/base/thread_local_storage.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/grid/manifold.h>
 #include <functional>
 #include <membranes/compiled_function.h>
+#include <membranes/expression_entry.h>
 #include <membranes/problem_data.h>
 #include <muParser.h>
 #include <optional>
@@ -60,218 +60,6 @@ namespace membranes
         }
       return constants;
     }
-
-
-
-    /** A point as `(x, y)`. */
-    template <int dim>
-    std::string
-    at(const Point<dim> &p)
-    {
-      std::ostringstream text;
-      text << "(";
-      for (unsigned int d = 0; d < dim; ++d)
-        text << (d > 0 ? ", " : "") << p[d];
-      text << ")";
-      return text.str();
-    }
-
-
-
-    /** The names of the variables: x, y. */
-    template <int dim>
-    std::vector<std::string>
-    variable_names()
-    {
-      return Utilities::split_string_list(
-        FunctionParser<dim>::default_variable_names());
-    }
-
-
-
-    /**
-     * Set up @p parser for @p expression as deal.II 9.4's FunctionParser
-     * sets up its own muparser objects (internal::FunctionParser::
-     * ParserImplementation::init_muparser()), so that an expression means
-     * the same and gives the same values, to the last bit: the
-     * @p constants, the variables x, y bound to the coordinates of
-     * @p point, deal.II's functions if, int, ceil, floor, cot, csc, sec,
-     * log, pow, erfc, rand, rand_seed and operators |, & (deal.II's own
-     * definitions, with the same permission to fold constants), and the
-     * blanks between a function name and its parenthesis removed.
-     */
-    template <int dim>
-    void
-    set_up(mu::Parser                          &parser,
-           const std::string                   &expression,
-           const std::map<std::string, double> &constants,
-           Point<dim>                          &point)
-    {
-      namespace deal_ii = dealii::internal::FunctionParser;
-      for (const auto &[name, value] : constants)
-        parser.DefineConst(name, value);
-      const auto names = variable_names<dim>();
-      for (unsigned int d = 0; d < dim; ++d)
-        parser.DefineVar(names[d], &point[d]);
-      parser.DefineFun("if", deal_ii::mu_if, true);
-      parser.DefineOprt("|", deal_ii::mu_or, 1);
-      parser.DefineOprt("&", deal_ii::mu_and, 2);
-      parser.DefineFun("int", deal_ii::mu_int, true);
-      parser.DefineFun("ceil", deal_ii::mu_ceil, true);
-      parser.DefineFun("cot", deal_ii::mu_cot, true);
-      parser.DefineFun("csc", deal_ii::mu_csc, true);
-      parser.DefineFun("floor", deal_ii::mu_floor, true);
-      parser.DefineFun("sec", deal_ii::mu_sec, true);
-      parser.DefineFun("log", deal_ii::mu_log, true);
-      parser.DefineFun("pow", deal_ii::mu_pow, true);
-      parser.DefineFun("erfc", deal_ii::mu_erfc, true);
-      parser.DefineFun("rand_seed", deal_ii::mu_rand_seed, true);
-      parser.DefineFun("rand", deal_ii::mu_rand, true);
-
-      std::string text = expression;
-      for (const std::string &name : deal_ii::get_function_names())
-        for (auto at = text.find(name); at != std::string::npos;
-             at      = text.find(name, at + name.size()))
-          while (
-            at + name.size() < text.size() &&
-            (text[at + name.size()] == ' ' || text[at + name.size()] == '\t'))
-            text.erase(at + name.size(), 1);
-      parser.SetExpr(text);
-    }
-
-
-
-    /**
-     * An entry of the scene that holds an expression, and the checks of its
-     * values: one that is not finite, or larger than max_magnitude in
-     * magnitude, is an InputError naming the entry and the point.
-     */
-    template <int dim>
-    class Entry
-    {
-    public:
-      Entry(const std::string &entry, const std::string &text)
-        : entry(entry)
-        , text(text)
-      {}
-
-      /** The InputError for this entry, which should be @p allowed. */
-      Parameters::InputError
-      invalid(const std::string &allowed) const
-      {
-        return Parameters::invalid_entry(entry, text, allowed);
-      }
-
-      /**
-       * Throw the InputError for @p what at @p p if @p value is not finite
-       * or larger than max_magnitude in magnitude.
-       */
-      void
-      check(const double value, const Point<dim> &p, const char *what) const
-      {
-        if (!(std::abs(value) <= Parameters::max_magnitude))
-          throw out_of_range(value, p, what);
-      }
-
-      /** Check the dim derivatives of @p gradient at @p p. */
-      void
-      check(const Tensor<1, dim> &gradient, const Point<dim> &p) const
-      {
-        static const char *const derivatives[] = {"derivative by x",
-                                                  "derivative by y",
-                                                  "derivative by z"};
-        for (unsigned int d = 0; d < dim; ++d)
-          check(gradient[d], p, derivatives[d]);
-      }
-
-    private:
-      /** The InputError of check(), kept out of its fast path. */
-      Parameters::InputError
-      out_of_range(const double      value,
-                   const Point<dim> &p,
-                   const char       *what) const
-      {
-        std::ostringstream allowed;
-        allowed << "its " << what << " at " << at(p) << " is " << value
-                << "; an expression must be finite and at most "
-                << Parameters::max_magnitude
-                << " in magnitude wherever it is evaluated";
-        return invalid(allowed.str());
-      }
-
-      const std::string entry;
-      const std::string text;
-    };
-
-
-
-    /**
-     * The expressions of one entry of the scene, separated by ';' (one for
-     * a function, dim for a gradient, as deal.II's FunctionParser reads a
-     * function with that many components), each in a muparser object set up
-     * by set_up(), their variables bound to the coordinates of one point.
-     */
-    template <int dim>
-    class ParsedEntry : public Entry<dim>
-    {
-    public:
-      /**
-       * Parse @p text, the value of entry @p entry, as @p n_components
-       * expressions with @p constants and the variables bound to @p point.
-       * Each is evaluated once at the origin, so that a syntax error or an
-       * unknown name surfaces here, as an InputError naming the entry,
-       * rather than mid-run; its value there is not checked (the origin
-       * need not be in the domain: the L-shape's loads are singular at its
-       * corner).
-       */
-      ParsedEntry(const std::string                   &entry,
-                  const std::string                   &text,
-                  const unsigned int                   n_components,
-                  const std::map<std::string, double> &constants,
-                  Point<dim>                          &point)
-        : Entry<dim>(entry, text)
-      {
-        const auto expressions = Utilities::split_string_list(text, ';');
-        if (expressions.size() != n_components)
-          throw this->invalid("expected " + std::to_string(n_components) +
-                              (n_components == 1 ?
-                                 " expression in x, y" :
-                                 " expressions in x, y separated by ';', "
-                                 "the derivatives by x and by y") +
-                              ", found " + std::to_string(expressions.size()));
-        for (unsigned int c = 0; c < n_components; ++c)
-          try
-            {
-              parsers.push_back(std::make_unique<mu::Parser>());
-              set_up(*parsers.back(), expressions[c], constants, point);
-              point = Point<dim>();
-              parsers.back()->Eval();
-            }
-          catch (const mu::ParserError &e)
-            {
-              throw this->invalid(
-                "not a valid expression in x, y (" +
-                (n_components == 1 ? "" : "'" + expressions[c] + "': ") +
-                e.GetMsg() + ")");
-            }
-      }
-
-      /**
-       * Expression @p c at the point that the variables are bound to: one
-       * run of muparser's bytecode, with no lock and no lookup (unlike
-       * FunctionParser::value(), which finds its parser in thread-local
-       * storage on every call; Expression finds the parsers of its thread
-       * once for all the points of a cell).
-       */
-      double
-      evaluate(const unsigned int c) const
-      {
-        return parsers[c]->Eval();
-      }
-
-    private:
-      std::vector<std::unique_ptr<mu::Parser>> parsers;
-    };
   } // namespace
 
 
@@ -456,7 +244,7 @@ namespace membranes
         : function(e.entry, e.expression, 1, e.constants, point)
       {
         if (!Utilities::trim(e.gradient_expression).empty())
-          exact_gradient = std::make_unique<ParsedEntry<dim>>(
+          exact_gradient = std::make_unique<ParsedExpressionEntry<dim>>(
             e.gradient_entry, e.gradient_expression, dim, e.constants, point);
       }
 
@@ -503,9 +291,9 @@ namespace membranes
       /** The variables x, y of every expression. */
       mutable Point<dim> point;
 
-      ParsedEntry<dim>                  function;
-      std::unique_ptr<ParsedEntry<dim>> exact_gradient;
-      double                            step_size = 1e-5;
+      ParsedExpressionEntry<dim>                  function;
+      std::unique_ptr<ParsedExpressionEntry<dim>> exact_gradient;
+      double                                      step_size = 1e-5;
     };
 
     /** The parsers of the calling thread, made on its first call. */
@@ -518,7 +306,7 @@ namespace membranes
       return *local;
     }
 
-    const Entry<dim>                    checks;
+    const ExpressionEntry<dim>          checks;
     const std::string                   entry, expression;
     const std::map<std::string, double> constants;
     const std::string                   gradient_entry, gradient_expression;
@@ -769,8 +557,8 @@ namespace membranes
               if (value < 0)
                 {
                   std::ostringstream allowed;
-                  allowed << name << " = " << value << " < 0 at " << at(p)
-                          << " on the boundary; " << name
+                  allowed << name << " = " << value << " < 0 at "
+                          << point_text(p) << " on the boundary; " << name
                           << " must be >= 0 there";
                   throw function->invalid(allowed.str());
                 }
@@ -827,7 +615,7 @@ namespace membranes
           if (!((entry - derivative).norm() <= 1e-8 * scale))
             {
               std::ostringstream allowed;
-              allowed << "at " << at(p) << " it is (" << entry
+              allowed << "at " << point_text(p) << " it is (" << entry
                       << ") but the derivative of the exact solution is ("
                       << derivative << ")";
               throw u->invalid_gradient(allowed.str());

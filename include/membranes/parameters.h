@@ -83,10 +83,14 @@ namespace membranes::Parameters
   constexpr double max_tension_ratio = 1e12;
 
   /**
-   * Read the scene @p file_name into @p prm. Any error is an InputError
-   * naming where it is (`Subsection/Entry`, or the subsection, and the line)
-   * and what is allowed there: the declared entries or subsections, or the
-   * pattern of the value.
+   * Read the scene @p file_name into @p prm by deal.II's parser
+   * (ParameterHandler::parse_input()), once the program has made sure that
+   * its `include` statements form no cycle (deal.II's parser would follow
+   * one until the stack overflows). Any error is an InputError naming where
+   * it is (the line, and `Subsection/Entry` or the subsection) and, for an
+   * entry or a subsection that is not declared or a value that does not
+   * match its pattern, what is allowed there: the declared entries or
+   * subsections, or the pattern.
    */
   void
   read_scene(ParameterHandler &prm, const std::string &file_name);
