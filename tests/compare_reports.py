@@ -4,9 +4,11 @@ report.csv files, or the nodal-values-NN.csv files of two runs.
 
 Usage::
 
-    compare_reports.py a.csv b.csv --columns c1,c2,... --rtol R [--atol A]
-                       [--scale value|column] [--one-sided]
-                       [--empty c1,c2,...]
+    compare_reports.py a.csv b.csv [--columns c1,c2,...] [--empty c1,c2,...]
+                       --rtol R [--atol A] [--scale value|column]
+                       [--one-sided]
+
+(``--columns``, ``--empty`` or both.)
 
 The files must have the same number of data rows, and for every named column
 and every row the two values must satisfy
@@ -157,7 +159,7 @@ def parse_arguments(argv):
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("first", metavar="a.csv")
     parser.add_argument("second", metavar="b.csv")
-    parser.add_argument("--columns", type=column_list, required=True,
+    parser.add_argument("--columns", type=column_list, default=[],
                         metavar="C1,C2,...", help="columns to compare")
     parser.add_argument("--rtol", type=non_negative_float, required=True,
                         help="relative tolerance")
@@ -172,7 +174,10 @@ def parse_arguments(argv):
     parser.add_argument("--empty", type=column_list, default=[],
                         metavar="C1,C2,...",
                         help="columns expected to be empty in both files")
-    return parser.parse_args(argv)
+    arguments = parser.parse_args(argv)
+    if not arguments.columns and not arguments.empty:
+        parser.error("no columns: give --columns, --empty or both")
+    return arguments
 
 
 def report_line(passed, name, message):
