@@ -50,7 +50,12 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
     using MatrixType = TrilinosWrappers::SparseMatrix;
 
-    /** The Amesos package of the direct solver. */
+    /**
+     * The Amesos package of the direct solver: MUMPS, a multifrontal LU
+     * factorization with pivoting that runs on all processes of the
+     * matrix (Amesos_Klu, always available, gathers the matrix on one
+     * process and is less accurate on these systems).
+     */
     static constexpr const char *direct_solver_package = "Amesos_Mumps";
 
     /** Largest problem that `auto` hands to the direct solver. */
