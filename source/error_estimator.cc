@@ -130,141 +130,46 @@ namespace membranes
 
 
 
+  /**
+   * What one thread needs on an edge between quadrilaterals: the two traces
+   * of the gradient on the edge, with matching points, from the nodal
+   * values of the cell (side 0) and of its neighbour (side 1).
+   */
   template <int dim>
-  void
-  ErrorEstimator<dim>::add_jump_terms(const DoFHandler<dim> &dof_handler,
-                                      const VectorType      &ghosted_solution,
-                                      Vector<double>        &indicators) const
+  struct ErrorEstimator<dim>::JumpScratch
   {
-    const FiniteElement<dim>                       &fe = *discretization.fe;
-    const std::array<FEValuesExtractors::Scalar, 2> membrane{
-      {FEValuesExtractors::Scalar(0), FEValuesExtractors::Scalar(1)}};
-
-    // What one thread needs on an edge: for quadrilaterals, the two traces
-    // on the edge, with matching points; the nodal values of a cell (and of
-    // its neighbour, side 1).
-    struct Scratch
+    JumpScratch(const Discretization<dim> &discretization)
     {
-      std::unique_ptr<FEInterfaceValues<dim>> interface_values;
-      std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
-      std::array<std::vector<double>, 2>                        local_dofs;
-    };
-    const auto make_scratch = [&]() {
-      auto scratch = std::make_unique<Scratch>();
-      for (auto &values : scratch->local_dofs)
+      const FiniteElement<dim> &fe = *discretization.fe;
+      for (auto &values : local_dofs)
         values.resize(fe.n_dofs_per_cell());
       if (!fe.reference_cell().is_simplex())
-        scratch->interface_values =
+        interface_values =
           std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
                                                    fe,
                                                    QGauss<dim - 1>(2),
                                                    update_gradients |
                                                      update_JxW_values |
                                                      update_normal_vectors);
-      return scratch;
-    };
+    }
 
-    // ∫_e |[μ_i ∂_n u_ih]|² for both membranes, on the edge that @p cell
-    // shares with its neighbour through face @p f.
-    std::function<std::array<double, 2>(
-      const typename DoFHandler<dim>::active_cell_iterator &,
-      const unsigned int,
-      Scratch &)>
-      jump_integrals;
+    std::unique_ptr<FEInterfaceValues<dim>>                   interface_values;
+    std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
+    std::array<std::vector<double>, 2>                        local_dofs;
+  };
 
-    // Triangles: P1 gradients are constant on each cell.
-    std::vector<std::array<Tensor<1, dim>, 2>> cell_gradient;
-    if (fe.reference_cell().is_simplex())
-      {
-        cell_gradient.resize(dof_handler.get_triangulation().n_active_cells());
-        FEValues<dim>               fe_values(*discretization.mapping,
-                                fe,
-                                QGaussSimplex<dim>(1),
-                                update_gradients);
-        std::vector<Tensor<1, dim>> gradient(1);
-        std::vector<double>         local_dofs(fe.n_dofs_per_cell());
-        for (const auto &cell : dof_handler.active_cell_iterators())
-          if (!cell->is_artificial())
-            {
-              fe_values.reinit(cell);
-              cell->get_dof_values(ghosted_solution,
-                                   local_dofs.begin(),
-                                   local_dofs.end());
-              for (unsigned int i = 0; i < 2; ++i)
-                {
-                  fe_values[membrane[i]]
-                    .get_function_gradients_from_local_dof_values(local_dofs,
-                                                                  gradient);
-                  cell_gradient[cell->active_cell_index()][i] = gradient[0];
-                }
-            }
-        jump_integrals =
-          [&](const auto &cell, const unsigned int f, Scratch &) {
-            const auto           face    = cell->face(f);
-            const Tensor<1, dim> tangent = face->vertex(1) - face->vertex(0);
-            Tensor<1, dim>       normal  = cross_product_2d(tangent);
-            const double         length  = tangent.norm();
-            normal /= length;
-            if (normal * (face->center() - cell->center()) < 0)
-              normal *= -1;
-            const auto           &neighbor = cell->neighbor(f);
-            std::array<double, 2> integrals;
-            for (unsigned int i = 0; i < 2; ++i)
-              integrals[i] =
-                std::pow(data.mu[i] *
-                           (cell_gradient[cell->active_cell_index()][i] -
-                            cell_gradient[neighbor->active_cell_index()][i]) *
-                           normal,
-                         2) *
-                length;
-            return integrals;
-          };
-      }
-    else
-      jump_integrals =
-        [&](const auto &cell, const unsigned int f, Scratch &scratch) {
-          FEInterfaceValues<dim> &interface_values = *scratch.interface_values;
-          const auto             &neighbor         = cell->neighbor(f);
-          if (cell->neighbor_is_coarser(f))
-            {
-              const auto [nf, nsf] = cell->neighbor_of_coarser_neighbor(f);
-              interface_values.reinit(
-                cell, f, numbers::invalid_unsigned_int, neighbor, nf, nsf);
-            }
-          else
-            interface_values.reinit(cell,
-                                    f,
-                                    numbers::invalid_unsigned_int,
-                                    neighbor,
-                                    cell->neighbor_of_neighbor(f),
-                                    numbers::invalid_unsigned_int);
-          cell->get_dof_values(ghosted_solution,
-                               scratch.local_dofs[0].begin(),
-                               scratch.local_dofs[0].end());
-          neighbor->get_dof_values(ghosted_solution,
-                                   scratch.local_dofs[1].begin(),
-                                   scratch.local_dofs[1].end());
-          const unsigned int    n_q = interface_values.n_quadrature_points;
-          std::array<double, 2> integrals{};
-          for (unsigned int i = 0; i < 2; ++i)
-            {
-              auto &traces = scratch.traces[i];
-              for (unsigned int side = 0; side < 2; ++side)
-                {
-                  traces[side].resize(n_q);
-                  interface_values.get_fe_face_values(side)[membrane[i]]
-                    .get_function_gradients_from_local_dof_values(
-                      scratch.local_dofs[side], traces[side]);
-                }
-              for (unsigned int q = 0; q < n_q; ++q)
-                integrals[i] +=
-                  std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
-                             interface_values.normal(q),
-                           2) *
-                  interface_values.JxW(q);
-            }
-          return integrals;
-        };
+
+
+  template <int dim>
+  void
+  ErrorEstimator<dim>::add_jump_terms(const DoFHandler<dim> &dof_handler,
+                                      const VectorType      &ghosted_solution,
+                                      Vector<double>        &indicators) const
+  {
+    const bool simplex = discretization.fe->reference_cell().is_simplex();
+    const std::vector<std::array<Tensor<1, dim>, 2>> cell_gradients =
+      simplex ? p1_gradients(dof_handler, ghosted_solution) :
+                std::vector<std::array<Tensor<1, dim>, 2>>();
 
     // Every interior edge once, from its finer side (or from the cell with
     // the smaller index between cells of the same level); half of the
@@ -280,8 +185,8 @@ namespace membranes
     using EdgeTerms = std::vector<EdgeTerm>;
     run_on_cells<EdgeTerms>(
       dof_handler,
-      make_scratch,
-      [&](const auto &cell, Scratch &scratch, EdgeTerms &terms) {
+      [&]() { return std::make_unique<JumpScratch>(discretization); },
+      [&](const CellIterator &cell, JumpScratch &scratch, EdgeTerms &terms) {
         terms.clear();
         if (cell->is_artificial())
           return;
@@ -294,7 +199,9 @@ namespace membranes
                 (!cell->neighbor_is_coarser(f) &&
                  neighbor->active_cell_index() < cell->active_cell_index()))
               continue;
-            const auto integrals = jump_integrals(cell, f, scratch);
+            const auto integrals =
+              simplex ? p1_jump_integrals(cell, f, cell_gradients) :
+                        q1_jump_integrals(cell, f, ghosted_solution, scratch);
             terms.push_back(
               {cell->active_cell_index(),
                neighbor->active_cell_index(),
@@ -314,6 +221,179 @@ namespace membranes
 
 
   template <int dim>
+  std::vector<std::array<Tensor<1, dim>, 2>>
+  ErrorEstimator<dim>::p1_gradients(const DoFHandler<dim> &dof_handler,
+                                    const VectorType &ghosted_solution) const
+  {
+    const FiniteElement<dim>                  &fe = *discretization.fe;
+    std::vector<std::array<Tensor<1, dim>, 2>> cell_gradients(
+      dof_handler.get_triangulation().n_active_cells());
+    FEValues<dim>               fe_values(*discretization.mapping,
+                            fe,
+                            QGaussSimplex<dim>(1),
+                            update_gradients);
+    std::vector<Tensor<1, dim>> gradient(1);
+    std::vector<double>         local_dofs(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial())
+        {
+          fe_values.reinit(cell);
+          cell->get_dof_values(ghosted_solution,
+                               local_dofs.begin(),
+                               local_dofs.end());
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              fe_values[FEValuesExtractors::Scalar(i)]
+                .get_function_gradients_from_local_dof_values(local_dofs,
+                                                              gradient);
+              cell_gradients[cell->active_cell_index()][i] = gradient[0];
+            }
+        }
+    return cell_gradients;
+  }
+
+
+
+  template <int dim>
+  std::array<double, 2>
+  ErrorEstimator<dim>::p1_jump_integrals(
+    const CellIterator                               &cell,
+    const unsigned int                                f,
+    const std::vector<std::array<Tensor<1, dim>, 2>> &cell_gradients) const
+  {
+    const auto           face    = cell->face(f);
+    const Tensor<1, dim> tangent = face->vertex(1) - face->vertex(0);
+    Tensor<1, dim>       normal  = cross_product_2d(tangent);
+    const double         length  = tangent.norm();
+    normal /= length;
+    if (normal * (face->center() - cell->center()) < 0)
+      normal *= -1;
+    const auto           &neighbor = cell->neighbor(f);
+    std::array<double, 2> integrals;
+    for (unsigned int i = 0; i < 2; ++i)
+      integrals[i] =
+        std::pow(data.mu[i] *
+                   (cell_gradients[cell->active_cell_index()][i] -
+                    cell_gradients[neighbor->active_cell_index()][i]) *
+                   normal,
+                 2) *
+        length;
+    return integrals;
+  }
+
+
+
+  template <int dim>
+  std::array<double, 2>
+  ErrorEstimator<dim>::q1_jump_integrals(const CellIterator &cell,
+                                         const unsigned int  f,
+                                         const VectorType   &ghosted_solution,
+                                         JumpScratch        &scratch) const
+  {
+    FEInterfaceValues<dim> &interface_values = *scratch.interface_values;
+    const auto             &neighbor         = cell->neighbor(f);
+    if (cell->neighbor_is_coarser(f))
+      {
+        const auto [nf, nsf] = cell->neighbor_of_coarser_neighbor(f);
+        interface_values.reinit(
+          cell, f, numbers::invalid_unsigned_int, neighbor, nf, nsf);
+      }
+    else
+      interface_values.reinit(cell,
+                              f,
+                              numbers::invalid_unsigned_int,
+                              neighbor,
+                              cell->neighbor_of_neighbor(f),
+                              numbers::invalid_unsigned_int);
+    cell->get_dof_values(ghosted_solution,
+                         scratch.local_dofs[0].begin(),
+                         scratch.local_dofs[0].end());
+    neighbor->get_dof_values(ghosted_solution,
+                             scratch.local_dofs[1].begin(),
+                             scratch.local_dofs[1].end());
+    const unsigned int    n_q = interface_values.n_quadrature_points;
+    std::array<double, 2> integrals{};
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        auto &traces = scratch.traces[i];
+        for (unsigned int side = 0; side < 2; ++side)
+          {
+            traces[side].resize(n_q);
+            interface_values
+              .get_fe_face_values(side)[FEValuesExtractors::Scalar(i)]
+              .get_function_gradients_from_local_dof_values(
+                scratch.local_dofs[side], traces[side]);
+          }
+        for (unsigned int q = 0; q < n_q; ++q)
+          integrals[i] += std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
+                                     interface_values.normal(q),
+                                   2) *
+                          interface_values.JxW(q);
+      }
+    return integrals;
+  }
+
+
+
+  /**
+   * What one thread needs on a cell for the flux estimator: u_ih, ∇u_ih,
+   * σ_ih, div σ_ih and λ̃_h at the quadrature points of the pieces
+   * K ∩ D_a.
+   */
+  template <int dim>
+  struct ErrorEstimator<dim>::FluxScratch
+  {
+    FluxScratch(const Discretization<dim> &discretization,
+                const DiscreteAction<dim> &action)
+      : values(discretization,
+               action,
+               update_values | update_gradients | update_jacobians |
+                 update_JxW_values)
+    {
+      for (unsigned int i = 0; i < 2; ++i)
+        {
+          u[i].resize(values.fe_values.n_quadrature_points);
+          grad_u[i].resize(values.fe_values.n_quadrature_points);
+        }
+    }
+
+    DualCellValues<dim>                        values;
+    std::array<std::vector<double>, 2>         u;
+    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+    std::vector<Tensor<1, dim>>                flux;
+    std::vector<double>                        divergence, lambda;
+  };
+
+
+
+  template <int dim>
+  typename ErrorEstimator<dim>::FluxTerms &
+  ErrorEstimator<dim>::FluxTerms::operator+=(const FluxTerms &other)
+  {
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        flux[i] += other.flux[i];
+        residual[i] += other.residual[i];
+      }
+    contact += other.contact;
+    return *this;
+  }
+
+
+
+  template <int dim>
+  double
+  ErrorEstimator<dim>::FluxTerms::eta_squared() const
+  {
+    double eta2 = 0;
+    for (unsigned int i = 0; i < 2; ++i)
+      eta2 += std::pow(std::sqrt(flux[i]) + std::sqrt(residual[i]), 2);
+    return eta2 + 2 * contact;
+  }
+
+
+
+  template <int dim>
   typename ErrorEstimator<dim>::FluxEstimate
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>         &dof_handler,
@@ -323,99 +403,87 @@ namespace membranes
     Vector<double>                &indicators,
     const MPI_Comm                 mpi_communicator) const
   {
-    struct Scratch
-    {
-      Scratch(const Discretization<dim> &discretization,
-              const DiscreteAction<dim> &action)
-        : values(discretization,
-                 action,
-                 update_values | update_gradients | update_jacobians |
-                   update_JxW_values)
-      {
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            u[i].resize(values.fe_values.n_quadrature_points);
-            grad_u[i].resize(values.fe_values.n_quadrature_points);
-          }
-      }
-      DualCellValues<dim>                        values;
-      std::array<std::vector<double>, 2>         u;
-      std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
-      std::vector<Tensor<1, dim>>                flux;
-      std::vector<double>                        divergence, lambda;
-    };
-    const std::array<double, 2> sign{{1., -1.}};
-
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    // η_F,i,K², η_R,i,K² and (λ_h, w_h)⁺_K of a cell; their sums
-    // Σ_K η_F,i,K², Σ_K η_R,i,K² and B = Σ_K (λ_h, w_h)⁺_K on this process.
-    using Sums = std::array<double, 5>;
-    Sums sums{};
-    run_on_cells<Sums>(
+    FluxTerms sums;
+    run_on_cells<FluxTerms>(
       dof_handler,
-      [&]() { return std::make_unique<Scratch>(discretization, action); },
-      [&](const auto &cell, Scratch &scratch, Sums &cell_sums) {
-        cell_sums = Sums{};
+      [&]() { return std::make_unique<FluxScratch>(discretization, action); },
+      [&](const CellIterator &cell, FluxScratch &scratch, FluxTerms &terms) {
+        terms = FluxTerms();
         if (!cell->is_locally_owned())
           return;
-        scratch.values.reinit(cell, ghosted_solution);
-        const FEValues<dim> &fe_values = scratch.values.fe_values;
-        action.nodal_lambda_values(fe_values, scratch.lambda);
-        const double h_K  = cell->diameter();
-        double       eta2 = 0;
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            const FEValuesExtractors::Scalar membrane(i);
-            fe_values[membrane].get_function_values_from_local_dof_values(
-              scratch.values.local_dofs, scratch.u[i]);
-            fe_values[membrane].get_function_gradients_from_local_dof_values(
-              scratch.values.local_dofs, scratch.grad_u[i]);
-            flux_reconstruction.flux_values(
-              cell, i, fe_values, scratch.flux, scratch.divergence);
-            const auto load      = flux_reconstruction.load_values(cell, i);
-            double     flux_term = 0, residual = 0;
-            for (const unsigned int q : fe_values.quadrature_point_indices())
-              {
-                flux_term +=
-                  (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
-                    .norm_square() *
-                  fe_values.JxW(q);
-                residual += std::pow(load[q] + sign[i] * scratch.lambda[q] -
-                                       scratch.divergence[q],
-                                     2) *
-                            fe_values.JxW(q);
-              }
-            flux_term /= data.mu[i];
-            residual *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
-            cell_sums[2 * i]     = flux_term;
-            cell_sums[2 * i + 1] = residual;
-            eta2 += std::pow(std::sqrt(flux_term) + std::sqrt(residual), 2);
-          }
-        double contact = 0;
-        for (const unsigned int q : fe_values.quadrature_point_indices())
-          contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
-                     fe_values.JxW(q);
-        cell_sums[4]                          = std::max(contact, 0.);
-        indicators[cell->active_cell_index()] = eta2 + 2 * cell_sums[4];
+        terms = flux_terms(
+          cell, ghosted_solution, action, flux_reconstruction, scratch);
+        indicators[cell->active_cell_index()] = terms.eta_squared();
       },
-      [&](const Sums &cell_sums) {
-        for (unsigned int k = 0; k < sums.size(); ++k)
-          sums[k] += cell_sums[k];
-      });
+      [&](const FluxTerms &terms) { sums += terms; });
 
-    for (double &sum : sums)
-      sum = Utilities::MPI::sum(sum, mpi_communicator);
-    FluxEstimate estimate;
-    double       eta2 = 2 * sums[4];
     for (unsigned int i = 0; i < 2; ++i)
-      eta2 += std::pow(std::sqrt(sums[2 * i]) + std::sqrt(sums[2 * i + 1]), 2);
-    estimate.eta         = std::sqrt(eta2);
-    estimate.flux        = std::sqrt(sums[0] + sums[2]);
-    estimate.oscillation = std::sqrt(sums[1] + sums[3]);
-    estimate.contact     = std::sqrt(2 * sums[4]);
+      {
+        sums.flux[i] = Utilities::MPI::sum(sums.flux[i], mpi_communicator);
+        sums.residual[i] =
+          Utilities::MPI::sum(sums.residual[i], mpi_communicator);
+      }
+    sums.contact = Utilities::MPI::sum(sums.contact, mpi_communicator);
+
+    FluxEstimate estimate;
+    estimate.eta         = std::sqrt(sums.eta_squared());
+    estimate.flux        = std::sqrt(sums.flux[0] + sums.flux[1]);
+    estimate.oscillation = std::sqrt(sums.residual[0] + sums.residual[1]);
+    estimate.contact     = std::sqrt(2 * sums.contact);
     estimate.boundary =
       boundary_data_part(dof_handler, ghosted_solution, mpi_communicator);
     return estimate;
+  }
+
+
+
+  template <int dim>
+  typename ErrorEstimator<dim>::FluxTerms
+  ErrorEstimator<dim>::flux_terms(
+    const CellIterator            &cell,
+    const VectorType              &ghosted_solution,
+    const DiscreteAction<dim>     &action,
+    const FluxReconstruction<dim> &flux_reconstruction,
+    FluxScratch                   &scratch) const
+  {
+    scratch.values.reinit(cell, ghosted_solution);
+    const FEValues<dim> &fe_values = scratch.values.fe_values;
+    action.nodal_lambda_values(fe_values, scratch.lambda);
+    const std::array<double, 2> sign{{1., -1.}};
+    const double                h_K = cell->diameter();
+    FluxTerms                   terms;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        const FEValuesExtractors::Scalar membrane(i);
+        fe_values[membrane].get_function_values_from_local_dof_values(
+          scratch.values.local_dofs, scratch.u[i]);
+        fe_values[membrane].get_function_gradients_from_local_dof_values(
+          scratch.values.local_dofs, scratch.grad_u[i]);
+        flux_reconstruction.flux_values(
+          cell, i, fe_values, scratch.flux, scratch.divergence);
+        const auto load = flux_reconstruction.load_values(cell, i);
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          {
+            terms.flux[i] +=
+              (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
+                .norm_square() *
+              fe_values.JxW(q);
+            terms.residual[i] +=
+              std::pow(load[q] + sign[i] * scratch.lambda[q] -
+                         scratch.divergence[q],
+                       2) *
+              fe_values.JxW(q);
+          }
+        terms.flux[i] /= data.mu[i];
+        terms.residual[i] *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
+      }
+    double contact = 0;
+    for (const unsigned int q : fe_values.quadrature_point_indices())
+      contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
+                 fe_values.JxW(q);
+    terms.contact = std::max(contact, 0.);
+    return terms;
   }
 
 

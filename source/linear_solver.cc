@@ -1,10 +1,9 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <deal.II/dofs/dof_tools.h>
-#include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
-#include <deal.II/lac/vector.h>
+#include <deal.II/lac/trilinos_solver.h>
 #include <membranes/linear_solver.h>
 
 namespace membranes
@@ -16,14 +15,7 @@ namespace membranes
     , mpi_communicator(mpi_communicator)
     , use_direct(false)
     , first_iterations(0)
-  {
-    if (type == Parameters::LinearSolverType::direct &&
-        Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
-      throw Parameters::invalid_entry(
-        "Solver/Linear solver",
-        "direct",
-        "UMFPACK runs on one process: use cg-amg or auto under MPI");
-  }
+  {}
 
 
 
@@ -96,38 +88,11 @@ namespace membranes
                                   VectorType       &x,
                                   const VectorType &rhs)
   {
-    // UMFPACK factorizes deal.II's own SparseMatrix: copy the (serial)
-    // Trilinos matrix into one, row by row from Epetra's storage.
-    const Epetra_CrsMatrix       &epetra         = matrix.trilinos_matrix();
-    const types::global_dof_index n              = matrix.m();
-    const auto                    for_each_entry = [&](const auto &action) {
-      for (int row = 0; row < epetra.NumMyRows(); ++row)
-        {
-          int     n_entries;
-          double *values;
-          int    *columns;
-          epetra.ExtractMyRowView(row, n_entries, values, columns);
-          for (int k = 0; k < n_entries; ++k)
-            action(epetra.GRID(row), epetra.GCID(columns[k]), values[k]);
-        }
-    };
-    DynamicSparsityPattern pattern(n, n);
-    for_each_entry(
-      [&](const auto i, const auto j, const double) { pattern.add(i, j); });
-    SparsityPattern sparsity;
-    sparsity.copy_from(pattern);
-    SparseMatrix<double> copy(sparsity);
-    for_each_entry([&](const auto i, const auto j, const double value) {
-      copy.set(i, j, value);
-    });
-
-    SparseDirectUMFPACK umfpack;
-    umfpack.initialize(copy);
-    Vector<double> solution(rhs);
-    umfpack.solve(solution);
-    for (types::global_dof_index i = 0; i < n; ++i)
-      x[i] = solution[i];
-    x.compress(VectorOperation::insert);
+    SolverControl                                  control;
+    TrilinosWrappers::SolverDirect::AdditionalData data(false,
+                                                        direct_solver_package);
+    TrilinosWrappers::SolverDirect                 solver(control, data);
+    solver.solve(matrix, x, rhs);
   }
 
 

@@ -9,64 +9,66 @@ namespace membranes
 {
   namespace
   {
-    /** The values of one row, in the order of Report::column_names(). */
-    std::vector<std::optional<double>>
-    row_values(const CycleRecord &r)
+    /**
+     * One field of a row of report.csv: the column name, the value (empty
+     * when the run does not compute it), and whether it counts something
+     * (a whole number).
+     */
+    struct Field
     {
-      return {r.cycle,
-              r.cells,
-              static_cast<double>(r.dofs),
-              r.active_set_iterations,
-              r.active_vertices,
-              r.wall_time,
-              r.cumulative_wall_time,
-              r.err_u1_H1,
-              r.err_u2_H1,
-              r.err_u1_L2,
-              r.err_u2_L2,
-              r.err_lambda_L2,
-              r.estimator,
-              r.effectivity,
-              r.kkt_residual,
-              r.min_w,
-              r.min_lambda,
-              r.prop12_defect,
-              r.complementarity_defect,
-              r.linear_iterations,
-              r.time_setup,
-              r.time_assembly,
-              r.time_solve,
-              r.time_postprocess,
-              r.err_energy,
-              r.time_estimate,
-              r.hanging_active_vertices,
-              r.flux_estimator,
-              r.flux_effectivity,
-              r.measure_defect,
-              r.conservation_defect,
-              r.balance_defect,
-              r.time_flux,
-              r.levels,
-              r.processes,
-              r.memory_mb,
-              r.linearization_estimate,
-              r.algebraic_estimate,
-              r.flux_estimator_flux,
-              r.flux_estimator_oscillation,
-              r.flux_estimator_contact,
-              r.flux_estimator_boundary,
-              r.time_errors};
-    }
+      std::string           name;
+      std::optional<double> value;
+      bool                  count = false;
+    };
 
-    /** Columns that hold whole numbers. */
-    bool
-    is_count(const std::string &column)
+    /** The row of one cycle, its fields in the order of the columns. */
+    std::vector<Field>
+    row(const CycleRecord &r)
     {
-      return column == "cycle" || column == "cells" || column == "dofs" ||
-             column == "active_set_iterations" || column == "active_vertices" ||
-             column == "linear_iterations" ||
-             column == "hanging_active_vertices" || column == "levels" ||
-             column == "processes";
+      const bool count = true;
+      return {{"cycle", r.cycle, count},
+              {"cells", r.cells, count},
+              {"dofs", static_cast<double>(r.dofs), count},
+              {"active_set_iterations", r.active_set_iterations, count},
+              {"active_vertices", r.active_vertices, count},
+              {"wall_time_s", r.wall_time},
+              {"cumulative_wall_time_s", r.cumulative_wall_time},
+              {"err_u1_H1", r.err_u1_H1},
+              {"err_u2_H1", r.err_u2_H1},
+              {"err_u1_L2", r.err_u1_L2},
+              {"err_u2_L2", r.err_u2_L2},
+              {"err_lambda_L2", r.err_lambda_L2},
+              {"estimator", r.estimator},
+              {"effectivity", r.effectivity},
+              {"kkt_residual", r.kkt_residual},
+              {"min_w", r.min_w},
+              {"min_lambda", r.min_lambda},
+              {"prop12_defect", r.prop12_defect},
+              {"complementarity_defect", r.complementarity_defect},
+              {"linear_iterations", r.linear_iterations, count},
+              {"time_setup_s", r.time_setup},
+              {"time_assembly_s", r.time_assembly},
+              {"time_solve_s", r.time_solve},
+              {"time_postprocess_s", r.time_postprocess},
+              {"err_energy", r.err_energy},
+              {"time_estimate_s", r.time_estimate},
+              {"hanging_active_vertices", r.hanging_active_vertices, count},
+              {"flux_estimator", r.flux_estimator},
+              {"flux_effectivity", r.flux_effectivity},
+              {"measure_defect", r.measure_defect},
+              {"conservation_defect", r.conservation_defect},
+              {"balance_defect", r.balance_defect},
+              {"time_flux_s", r.time_flux},
+              {"levels", r.levels, count},
+              {"processes", r.processes, count},
+              {"memory_mb", r.memory_mb},
+              {"eta_linearization", r.linearization_estimate},
+              {"eta_algebraic", r.algebraic_estimate},
+              {"flux_estimator_flux", r.flux_estimator_flux},
+              {"flux_estimator_oscillation", r.flux_estimator_oscillation},
+              {"flux_estimator_contact", r.flux_estimator_contact},
+              {"flux_estimator_boundary", r.flux_estimator_boundary},
+              {"time_errors_s", r.time_errors}};
     }
   } // namespace
 
@@ -75,49 +77,12 @@ namespace membranes
   const std::vector<std::string> &
   Report::column_names()
   {
-    static const std::vector<std::string> names{"cycle",
-                                                "cells",
-                                                "dofs",
-                                                "active_set_iterations",
-                                                "active_vertices",
-                                                "wall_time_s",
-                                                "cumulative_wall_time_s",
-                                                "err_u1_H1",
-                                                "err_u2_H1",
-                                                "err_u1_L2",
-                                                "err_u2_L2",
-                                                "err_lambda_L2",
-                                                "estimator",
-                                                "effectivity",
-                                                "kkt_residual",
-                                                "min_w",
-                                                "min_lambda",
-                                                "prop12_defect",
-                                                "complementarity_defect",
-                                                "linear_iterations",
-                                                "time_setup_s",
-                                                "time_assembly_s",
-                                                "time_solve_s",
-                                                "time_postprocess_s",
-                                                "err_energy",
-                                                "time_estimate_s",
-                                                "hanging_active_vertices",
-                                                "flux_estimator",
-                                                "flux_effectivity",
-                                                "measure_defect",
-                                                "conservation_defect",
-                                                "balance_defect",
-                                                "time_flux_s",
-                                                "levels",
-                                                "processes",
-                                                "memory_mb",
-                                                "eta_linearization",
-                                                "eta_algebraic",
-                                                "flux_estimator_flux",
-                                                "flux_estimator_oscillation",
-                                                "flux_estimator_contact",
-                                                "flux_estimator_boundary",
-                                                "time_errors_s"};
+    static const std::vector<std::string> names = [] {
+      std::vector<std::string> names;
+      for (const Field &field : row(CycleRecord()))
+        names.push_back(field.name);
+      return names;
+    }();
     return names;
   }
 
@@ -152,13 +117,13 @@ namespace membranes
                        out << '\n' << std::setprecision(12);
                        for (const CycleRecord &record : records)
                          {
-                           const auto values = row_values(record);
-                           for (unsigned int c = 0; c < values.size(); ++c)
+                           const auto fields = row(record);
+                           for (unsigned int c = 0; c < fields.size(); ++c)
                              {
                                if (c > 0)
                                  out << ',';
-                               if (values[c])
-                                 out << *values[c];
+                               if (fields[c].value)
+                                 out << *fields[c].value;
                              }
                            out << '\n';
                          }
@@ -171,7 +136,6 @@ namespace membranes
   Report::print_convergence_table(const bool rates_in_dofs)
   {
     ConvergenceTable               table;
-    const auto                    &names = column_names();
     const std::vector<std::string> shown{"cycle",
                                          "cells",
                                          "dofs",
@@ -193,20 +157,17 @@ namespace membranes
     // effectivity).
     std::set<std::string> filled;
     for (const CycleRecord &record : records)
-      {
-        const auto values = row_values(record);
-        for (unsigned int c = 0; c < names.size(); ++c)
-          if (std::find(shown.begin(), shown.end(), names[c]) != shown.end() &&
-              values[c])
-            {
-              if (is_count(names[c]))
-                table.add_value(names[c],
-                                static_cast<unsigned long long>(*values[c]));
-              else
-                table.add_value(names[c], *values[c]);
-              filled.insert(names[c]);
-            }
-      }
+      for (const Field &field : row(record))
+        if (std::find(shown.begin(), shown.end(), field.name) != shown.end() &&
+            field.value)
+          {
+            if (field.count)
+              table.add_value(field.name,
+                              static_cast<unsigned long long>(*field.value));
+            else
+              table.add_value(field.name, *field.value);
+            filled.insert(field.name);
+          }
     for (const std::string &column : shown)
       if (filled.count(column) != 0 &&
           (column.rfind("err_", 0) == 0 ||

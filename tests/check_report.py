@@ -46,6 +46,12 @@ Checks (COL is a column name from the header, VALUE a number):
     The file has exactly N data rows.
 ``--decreasing COL``
     The non-empty values of COL strictly decrease from row to row.
+``--hanging-nodes N``
+    Each of the last N meshes has hanging nodes: fewer ``cells`` than the
+    first mesh refined uniformly to its number of ``levels``,
+    cells < cells_0 4^(levels - levels_0) (a refined quadrilateral or
+    triangle has four children), so that it has active cells of different
+    levels, and where two of them meet, a hanging vertex.
 
 Checks that look at non-empty values (``--max``, ``--min``,
 ``--max-after-first``, ``--max-last``, ``--min-last``, ``--decreasing``)
@@ -358,6 +364,19 @@ def check_decreasing(report, column):
     return ok, f"values [{shown}]"
 
 
+def check_hanging_nodes(report, count):
+    """The last N meshes have cells of different levels."""
+    cells, levels = report.values("cells"), report.values("levels")
+    if count < 1 or len(cells) < count or None in cells + levels:
+        return False, f"needs {max(count, 1)} rows with cells and levels"
+    uniform = [cells[0] * 4 ** (level - levels[0]) for level in levels]
+    last = range(len(cells) - count, len(cells))
+    shown = ", ".join(f"{fmt(cells[row])} < {fmt(uniform[row])}"
+                      for row in last)
+    ok = all(cells[row] < uniform[row] for row in last)
+    return ok, f"cells against uniform refinement: {shown}"
+
+
 # option -> (check function, argparse type, how to print the argument)
 CHECKS = {
     "--rate": (check_rate, lambda s: split_bound(s, ">="),
@@ -385,6 +404,7 @@ CHECKS = {
     "--filled": (check_filled, str, str),
     "--rows": (check_rows, non_negative_int, str),
     "--decreasing": (check_decreasing, str, str),
+    "--hanging-nodes": (check_hanging_nodes, non_negative_int, str),
 }
 
 METAVARS = {"--rate": "COL>=VALUE", "--max-rate": "COL<=VALUE",
@@ -393,7 +413,7 @@ METAVARS = {"--rate": "COL>=VALUE", "--max-rate": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
             "--max-last": "COL<=VALUE", "--min-last": "COL>=VALUE",
             "--empty": "COL", "--filled": "COL", "--rows": "N",
-            "--decreasing": "COL"}
+            "--decreasing": "COL", "--hanging-nodes": "N"}
 
 
 class AppendCheck(argparse.Action):
@@ -427,6 +447,8 @@ def columns_of(option, argument):
         return [argument[0]]
     if option == "--rows":
         return []
+    if option == "--hanging-nodes":
+        return ["cells", "levels"]
     return [argument]
 
 

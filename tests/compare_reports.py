@@ -4,8 +4,11 @@ report.csv files, or the nodal-values-NN.csv files of two runs.
 
 Usage::
 
-    compare_reports.py a.csv b.csv --columns c1,c2,... --rtol R [--atol A]
-                       [--scale value|column] [--one-sided]
+    compare_reports.py a.csv b.csv [--columns c1,c2,...] [--empty c1,c2,...]
+                       --rtol R [--atol A] [--scale value|column]
+                       [--one-sided]
+
+(``--columns``, ``--empty`` or both.)
 
 The files must have the same number of data rows, and for every named column
 and every row the two values must satisfy
@@ -17,8 +20,11 @@ with S = max(|a|, |b|) (``--scale value``, the default), or S the largest
 to the max norm, the right measure for nodal values that pass through zero).
 With ``--rtol 0`` (and no ``--atol``) the values must be equal, which is
 the right test for integer columns such as ``dofs`` or ``active_vertices``.
-Two empty fields agree; an empty field never agrees with a number; NaN never
-agrees with anything.  With ``--one-sided`` only b - a is bounded so
+Two empty fields agree (a column such as ``eta_linearization`` is empty on
+the first mesh); an empty field never agrees with a number; NaN never agrees
+with anything.  A column empty in every row of both files compares nothing,
+and fails, unless ``--empty`` names it: the columns ``--empty`` names are
+expected to be empty in every row of both files, and fail otherwise.  With ``--one-sided`` only b - a is bounded so
 (b <= a always agrees): b costs or errs at most that much more than a, e.g.
 ``--rtol 0 --one-sided`` on an iteration count says b <= a.  Columns are
 looked up by name in each file's header.
@@ -89,6 +95,9 @@ def compare_column(column, first, second, rtol, atol, scale_by_column,
                for text_a, text_b in pairs]
     scale = (column_scale([v for pair in numbers for v in pair])
              if scale_by_column else None)
+    if all(a is None and b is None for a, b in numbers):
+        return False, (f"empty in both files over {len(pairs)} rows: nothing "
+                       "to compare (--empty names a column expected empty)")
     mismatches = []
     largest = [0.0, 0.0]
     for row, ((text_a, text_b), (a, b)) in enumerate(zip(pairs, numbers)):
@@ -109,6 +118,19 @@ def compare_column(column, first, second, rtol, atol, scale_by_column,
                     + ", ".join(mismatches[:shown])
                     + (", ..." if len(mismatches) > shown else ""))
     return not mismatches, message
+
+
+def check_empty_column(column, first, second):
+    """Whether a column is empty in every row of both files; return
+    (passed, message)."""
+    filled = [f"{path} row {row}: {record[column]}"
+              for path, rows in (first, second)
+              for row, record in enumerate(rows) if record[column].strip()]
+    if filled:
+        return False, (f"expected empty, has {len(filled)} values: "
+                       + ", ".join(filled[:5])
+                       + (", ..." if len(filled) > 5 else ""))
+    return True, "empty in both files, as expected"
 
 
 def non_negative_float(text):
@@ -137,7 +159,7 @@ def parse_arguments(argv):
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("first", metavar="a.csv")
     parser.add_argument("second", metavar="b.csv")
-    parser.add_argument("--columns", type=column_list, required=True,
+    parser.add_argument("--columns", type=column_list, default=[],
                         metavar="C1,C2,...", help="columns to compare")
     parser.add_argument("--rtol", type=non_negative_float, required=True,
                         help="relative tolerance")
@@ -149,7 +171,13 @@ def parse_arguments(argv):
                         "or of the whole column (column)")
     parser.add_argument("--one-sided", action="store_true",
                         help="bound only b - a: b <= a always agrees")
-    return parser.parse_args(argv)
+    parser.add_argument("--empty", type=column_list, default=[],
+                        metavar="C1,C2,...",
+                        help="columns expected to be empty in both files")
+    arguments = parser.parse_args(argv)
+    if not arguments.columns and not arguments.empty:
+        parser.error("no columns: give --columns, --empty or both")
+    return arguments
 
 
 def report_line(passed, name, message):
@@ -165,7 +193,7 @@ def compare(arguments):
     print(f"comparing {arguments.first} and {arguments.second}")
     verdicts = [report_line(len(rows_a) == len(rows_b), "rows",
                             f"{len(rows_a)} vs {len(rows_b)}")]
-    for column in arguments.columns:
+    for column in dict.fromkeys(arguments.columns + arguments.empty):
         missing = [path for path, header in ((arguments.first, header_a),
                                              (arguments.second, header_b))
                    if column not in header]
@@ -173,11 +201,15 @@ def compare(arguments):
             verdicts.append(report_line(False, column, "unknown column in "
                                         + " and ".join(missing)))
             continue
+        first = (arguments.first, rows_a)
+        second = (arguments.second, rows_b)
         try:
-            passed, message = compare_column(
-                column, (arguments.first, rows_a),
-                (arguments.second, rows_b), arguments.rtol, arguments.atol,
-                arguments.scale == "column", arguments.one_sided)
+            if column in arguments.empty:
+                passed, message = check_empty_column(column, first, second)
+            else:
+                passed, message = compare_column(
+                    column, first, second, arguments.rtol, arguments.atol,
+                    arguments.scale == "column", arguments.one_sided)
         except ReportError as error:
             passed, message = False, str(error)
         verdicts.append(report_line(passed, column, message))

@@ -1,7 +1,9 @@
 #ifndef membranes_error_estimator_h
 #define membranes_error_estimator_h
 
+#include <array>
 #include <deal.II/base/index_set.h>
+#include <deal.II/base/tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
@@ -29,14 +31,14 @@ namespace membranes
    *                     + (h_K/π)² ‖f_i − f_ih‖²_K ]
    *          + 2 (λ_h, u1h − u2h)⁺_K,
    *
-   * with s_1 = +1, s_2 = −1 (the signs of λ in (1.1)), f_ih the mean of f_i
-   * on K (4.14), λ_h piecewise constant on the dual cells (integrated over
-   * the pieces K ∩ D_a with the FluxReconstruction's quadrature; zero in the
-   * strip ω \ ω_h along the boundary), [·] the jump across interior edges (on
-   * edges with a hanging node, across each of the two small edges).
+   * with s_1 = +1, s_2 = −1 (−μ_i Δu_i = f_i + s_i λ by (1.1)), f_ih the mean
+   * of f_i on K (4.14), λ_h piecewise constant on the dual cells (integrated
+   * over the pieces K ∩ D_a with the FluxReconstruction's quadrature; zero in
+   * the strip ω \ ω_h along the boundary), [·] the jump across interior edges
+   * (on edges with a hanging node, across each of the two small edges).
    *
    * The bracket is the classical residual estimator of the Poisson problem
-   * −μ_i Δu_i = f_i − s_i λ for each membrane, with λ replaced by the
+   * −μ_i Δu_i = f_i + s_i λ for each membrane, with λ replaced by the
    * discrete action λ_h of (4.5); weighting membrane i by μ_i⁻¹ makes each
    * bracket estimate μ_i |u_i − u_ih|²_{H1} with constants independent of
    * μ_i, so that η estimates the energy error
@@ -161,6 +163,8 @@ namespace membranes
                   const MPI_Comm                 mpi_communicator) const;
 
   private:
+    using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
+
     /** Element residuals, oscillation and the contact term. */
     void
     add_cell_terms(const DoFHandler<dim>     &dof_handler,
@@ -179,6 +183,66 @@ namespace membranes
     add_jump_terms(const DoFHandler<dim> &dof_handler,
                    const VectorType      &ghosted_solution,
                    Vector<double>        &indicators) const;
+
+    /** The traces on an edge between quadrilaterals (defined in the .cc). */
+    struct JumpScratch;
+
+    /**
+     * On triangles: the constant gradients ∇u_1h, ∇u_2h of P1 on every
+     * cell that is not artificial, indexed by active_cell_index().
+     */
+    std::vector<std::array<Tensor<1, dim>, 2>>
+    p1_gradients(const DoFHandler<dim> &dof_handler,
+                 const VectorType      &ghosted_solution) const;
+
+    /**
+     * ∫_e |[μ_i ∂_n u_ih]|² (i = 1, 2) on the edge @p f of @p cell between
+     * triangles, from the cell gradients of p1_gradients().
+     */
+    std::array<double, 2>
+    p1_jump_integrals(
+      const CellIterator                               &cell,
+      const unsigned int                                f,
+      const std::vector<std::array<Tensor<1, dim>, 2>> &cell_gradients) const;
+
+    /**
+     * The same between quadrilaterals, by FEInterfaceValues (the normal
+     * derivative of Q1 varies along the edge).
+     */
+    std::array<double, 2>
+    q1_jump_integrals(const CellIterator &cell,
+                      const unsigned int  f,
+                      const VectorType   &ghosted_solution,
+                      JumpScratch        &scratch) const;
+
+    /**
+     * The terms of the flux estimator, on one cell K or summed over cells:
+     * η_F,i² = μ_i⁻¹ ‖μ_i ∇u_ih + σ_ih‖², η_R,i² = (h_K/π)² μ_i⁻¹
+     * ‖f_i + s_i λ̃_h − div σ_ih‖² and (λ̃_h, u1h − u2h)⁺.
+     */
+    struct FluxTerms
+    {
+      std::array<double, 2> flux{}, residual{};
+      double                contact = 0;
+
+      FluxTerms &
+      operator+=(const FluxTerms &other);
+
+      /** Σ_i (η_F,i + η_R,i)² + 2 (λ̃_h, u1h − u2h)⁺. */
+      double
+      eta_squared() const;
+    };
+
+    /** The values of one cell for flux_terms() (defined in the .cc). */
+    struct FluxScratch;
+
+    /** The FluxTerms of one locally owned cell. */
+    FluxTerms
+    flux_terms(const CellIterator            &cell,
+               const VectorType              &ghosted_solution,
+               const DiscreteAction<dim>     &action,
+               const FluxReconstruction<dim> &flux_reconstruction,
+               FluxScratch                   &scratch) const;
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;

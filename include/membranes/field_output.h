@@ -20,12 +20,12 @@ namespace membranes
    * Field output, each file to a temporary name and renamed, so
    * that no half-written file is left:
    * - for ParaView (`Write vtu`), one VTU file per cycle with u1, u2,
-   *   w = u1 − u2, λ_h (the nodal values λ_a), the active set indicator,
-   *   the subdomain (the process that owns the cell) and, when computed,
-   *   the error indicator η_K, and a .pvd file that lists the cycles. On
-   *   N > 1 processes each writes its own cells to solution-NN.PPPP.vtu
-   *   and the first one the record solution-NN.pvtu that joins them (the
-   *   .pvd lists the records);
+   *   w = u1 − u2, λ_h (the nodal values λ_a of (4.5)), the active set
+   *   indicator, the subdomain (the process that owns the cell) and, when
+   *   computed, the error indicator η_K, and a .pvd file that lists the
+   *   cycles. On N > 1 processes each writes its own cells to
+   *   solution-NN.PPPP.vtu and the first one the record solution-NN.pvtu
+   *   that joins them (the .pvd lists the records);
    * - for comparisons to round-off (`Write nodal values`), one CSV file
    *   per cycle, nodal-values-NN.csv, with one row per vertex in the order
    *   of its position (x, then y), so that runs on different numbers of
@@ -59,7 +59,7 @@ namespace membranes
           const Vector<double>  *indicators);
 
     /**
-     * Write the sub-mesh S_h of the dual mesh of cycle @p cycle as
+     * Write the sub-mesh S_h of the dual mesh (§4.2) of cycle @p cycle as
      * dual-mesh-NN.vtu (.pvtu on N > 1 processes), one triangle per patch
      * with the data @p names (see FluxReconstruction::patches()), and a
      * dual-mesh.pvd over cycles.

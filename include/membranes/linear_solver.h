@@ -2,9 +2,6 @@
 #define membranes_linear_solver_h
 
 #include <deal.II/dofs/dof_handler.h>
-#include <deal.II/lac/sparse_direct.h>
-#include <deal.II/lac/sparse_matrix.h>
-#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -20,8 +17,9 @@ namespace membranes
    * The linear solves inside the active set method: the condensed,
    * symmetric positive definite system of one iteration.
    *
-   * - `direct`: UMFPACK (SuiteSparse) on a copy of the matrix; one process
-   *   only.
+   * - `direct`: the sparse LU factorization of Trilinos Amesos
+   *   (TrilinosWrappers::SolverDirect with direct_solver_package) of the
+   *   distributed matrix itself, on any number of processes.
    * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
    *   multigrid, with one constant near-null-space mode per component of
    *   the DoFHandler (per membrane for (u1, u2), one for s or w).
@@ -52,16 +50,20 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
     using MatrixType = TrilinosWrappers::SparseMatrix;
 
-    /** Largest problem that `auto` hands to UMFPACK. */
+    /**
+     * The Amesos package of the direct solver: MUMPS, a multifrontal LU
+     * factorization with pivoting that runs on all processes of the
+     * matrix (Amesos_Klu, always available, gathers the matrix on one
+     * process and is less accurate on these systems).
+     */
+    static constexpr const char *direct_solver_package = "Amesos_Mumps";
+
+    /** Largest problem that `auto` hands to the direct solver. */
     static constexpr types::global_dof_index direct_solver_dof_limit = 10000;
 
     /** CG iterations a reused hierarchy may need beyond twice its first. */
     static constexpr unsigned int rebuild_slack = 5;
 
-    /**
-     * Throws if @p type is `direct` on more than one process (UMFPACK is
-     * serial); this happens before the run, on every process alike.
-     */
     LinearSolver(const Parameters::LinearSolverType type,
                  const MPI_Comm                     mpi_communicator);
 

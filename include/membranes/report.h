@@ -102,6 +102,10 @@ namespace membranes
    * a stopped run never leaves a half-written file), and at the end the
    * same numbers as a deal.II ConvergenceTable with observed rates in h
    * (h ~ DoFs^{-1/2}) on the terminal.
+   *
+   * A row is one list of (column name, value) pairs, made from a
+   * CycleRecord in report.cc: adding a column is one line there (and the
+   * member of CycleRecord it reports).
    */
   class Report
   {
