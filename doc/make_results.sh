@@ -265,10 +265,10 @@ for section in $sections; do
       >"$work/figures.log"
     mapfile -t drawn < <(sed -n 's/^\$ //p' "$work/figures.log")
     commands+=("${drawn[@]}")
-    for image in dual-mesh case-m-fields slit-adaptive-mesh; do
+    for image in membranes dual-mesh case-m-fields slit-adaptive-mesh; do
       figure "$work/figures/$image.png" "$image.png"
     done
-    echo "The three figures of meshes and fields: dual-mesh.png, case-m-fields.png, slit-adaptive-mesh.png." |
+    echo "The figures membranes.png (from the exact solution of case M, no run), dual-mesh.png, case-m-fields.png and slit-adaptive-mesh.png." |
       block doc/tutorial.md figures
     ;;
 
