@@ -16,8 +16,8 @@ VTK):
 * ``dual-mesh.png``: case M on triangles, one global refinement, the flux
   reconstruction on: the primal mesh and the sub-triangles (a, m_e, b_K) of
   the dual mesh, coloured by their dual vertex a, as Fig. 1 of the paper;
-* ``case-m-fields.png``: case M on Q1, 5 cycles: u1 − u2, λ_h (the nodal
-  λ_a) and the active set, with the exact contact circle r = 1/2;
+* ``case-m-fields.png``: case M on Q1, 5 cycles: u1, u2, u1 − u2, λ_h (the
+  nodal λ_a) and the active set, with the exact contact circle r = 1/2;
 * ``slit-adaptive-mesh.png``: the slit scene, 12 adaptive cycles: the mesh
   refined towards the crack tip, with the slit and the contact disk.
 
@@ -185,10 +185,11 @@ def fields_figure(membranes, out):
     vtu = read_vtu(os.path.join(directory, "solution-04.vtu"))
     x, y = zip(*vtu["points"])
     mesh = Triangulation(x, y, triangles(vtu))
-    figure, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    figure, axes = plt.subplots(1, 4, figsize=(21, 4.8))
     for axis, name, title in ((axes[0], "u1", "$u_{1h}$"),
-                              (axes[1], "u1_minus_u2", "$u_{1h}-u_{2h}$"),
-                              (axes[2], "lambda_h", r"$\lambda_a$ and the active set")):
+                              (axes[1], "u2", "$u_{2h}$"),
+                              (axes[2], "u1_minus_u2", "$u_{1h}-u_{2h}$"),
+                              (axes[3], "lambda_h", r"$\lambda_a$ and the active set")):
         plot = axis.tripcolor(mesh, vtu[name], shading="gouraud",
                               cmap="viridis")
         figure.colorbar(plot, ax=axis, shrink=0.85)
@@ -196,7 +197,7 @@ def fields_figure(membranes, out):
         axis.set_title(title)
     active = [p for p, a in zip(vtu["points"], vtu["active_set"]) if a > 0.5]
     if active:
-        axes[2].plot(*zip(*active), ".", color="white", markersize=1.5)
+        axes[3].plot(*zip(*active), ".", color="white", markersize=1.5)
     for axis in axes:
         circle = plt.Circle((0, 0), 0.5, fill=False, color="red",
                             linestyle="--", linewidth=1)
