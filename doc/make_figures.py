@@ -6,15 +6,18 @@ Usage::
     /usr/bin/python3 doc/make_figures.py [path/to/membranes] [output-dir]
 
 Defaults: build/membranes of this repository and /tmp/membranes-figures.
-Runs three small scenes with VTU output and draws from the VTU files the
+Draws the picture of the problem from the exact solution of case M, then
+runs three small scenes with VTU output and draws from the VTU files the
 program writes (deal.II's zlib-compressed base64 format, read here without
 VTK):
 
+* ``membranes.png``: the two membranes of case M along the line y = 0, the
+  contact zone and the action lambda there (no run of the program);
 * ``dual-mesh.png``: case M on triangles, one global refinement, the flux
   reconstruction on: the primal mesh and the sub-triangles (a, m_e, b_K) of
   the dual mesh, coloured by their dual vertex a, as Fig. 1 of the paper;
-* ``case-m-fields.png``: case M on Q1, 5 cycles: u1 − u2, λ_h (the nodal
-  λ_a) and the active set, with the exact contact circle r = 1/2;
+* ``case-m-fields.png``: case M on Q1, 5 cycles: u1, u2, u1 − u2, λ_h (the
+  nodal λ_a) and the active set, with the exact contact circle r = 1/2;
 * ``slit-adaptive-mesh.png``: the slit scene, 12 adaptive cycles: the mesh
   refined towards the crack tip, with the slit and the contact disk.
 
@@ -120,6 +123,40 @@ def save(figure, path):
     print("wrote " + path)
 
 
+def problem_figure(out):
+    """Case M (mu1 = 1, mu2 = 2, R = 1/2) along y = 0: u1 and u2, which
+    touch for |x| < R, where the action lambda = 8 R^2 mu1 mu2/(mu1 + mu2)
+    pushes membrane 1 up and membrane 2 down."""
+    mu1, mu2, radius = 1.0, 2.0, 0.5
+    share = mu1 / (mu1 + mu2)
+    action = 8 * radius**2 * mu1 * mu2 / (mu1 + mu2)
+    xs = [-1 + 2 * k / 400 for k in range(401)]
+    base = [-(1 - x * x) for x in xs]
+    bump = [(x * x - radius**2)**2 for x in xs]
+    inside = [abs(x) < radius for x in xs]
+    u1 = [b + (share if i else 1) * q for b, q, i in zip(base, bump, inside)]
+    u2 = [b + (share * q if i else 0) for b, q, i in zip(base, bump, inside)]
+    figure, axes = plt.subplots(figsize=(8, 3.6))
+    axes.plot(xs, u1, color="tab:blue", linewidth=2,
+              label="membrane 1, $u_1$ ($u_1=g$ on the boundary)")
+    axes.plot(xs, u2, color="tab:orange", linewidth=2, linestyle="--",
+              label="membrane 2, $u_2$ ($u_2=0$ on the boundary)")
+    axes.axvspan(-radius, radius, color="0.9", zorder=0,
+                 label=r"contact: $u_1=u_2$, $\lambda=%g>0$" % round(action, 3))
+    for x in (-0.4, -0.2, 0, 0.2, 0.4):
+        y = -(1 - x * x) + share * (x * x - radius**2)**2
+        axes.annotate("", xy=(x, y + 0.12), xytext=(x, y),
+                      arrowprops={"arrowstyle": "->", "color": "tab:red"})
+    axes.text(0, -0.72, r"$\lambda$ pushes membrane 1 up", ha="center",
+              color="tab:red")
+    axes.set_xlabel("$x$ (on the line $y=0$)")
+    axes.set_title(r"Case M: $\mu_1=1$, $\mu_2=2$; the gap $u_1-u_2\geq0$ "
+                   "closes on the disk $r<1/2$")
+    axes.legend(loc="upper center", fontsize=8, ncol=1)
+    axes.set_ylim(-1.15, 0.75)
+    save(figure, os.path.join(out, "membranes.png"))
+
+
 def dual_mesh_figure(membranes, out):
     directory = os.path.join(out, "dual-mesh")
     run(membranes, "case-m-triangle.prm", directory,
@@ -148,10 +185,11 @@ def fields_figure(membranes, out):
     vtu = read_vtu(os.path.join(directory, "solution-04.vtu"))
     x, y = zip(*vtu["points"])
     mesh = Triangulation(x, y, triangles(vtu))
-    figure, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    figure, axes = plt.subplots(1, 4, figsize=(21, 4.8))
     for axis, name, title in ((axes[0], "u1", "$u_{1h}$"),
-                              (axes[1], "u1_minus_u2", "$u_{1h}-u_{2h}$"),
-                              (axes[2], "lambda_h", r"$\lambda_a$ and the active set")):
+                              (axes[1], "u2", "$u_{2h}$"),
+                              (axes[2], "u1_minus_u2", "$u_{1h}-u_{2h}$"),
+                              (axes[3], "lambda_h", r"$\lambda_a$ and the active set")):
         plot = axis.tripcolor(mesh, vtu[name], shading="gouraud",
                               cmap="viridis")
         figure.colorbar(plot, ax=axis, shrink=0.85)
@@ -159,7 +197,7 @@ def fields_figure(membranes, out):
         axis.set_title(title)
     active = [p for p, a in zip(vtu["points"], vtu["active_set"]) if a > 0.5]
     if active:
-        axes[2].plot(*zip(*active), ".", color="white", markersize=1.5)
+        axes[3].plot(*zip(*active), ".", color="white", markersize=1.5)
     for axis in axes:
         circle = plt.Circle((0, 0), 0.5, fill=False, color="red",
                             linestyle="--", linewidth=1)
@@ -190,6 +228,7 @@ def main():
         ROOT, "build", "membranes")
     out = sys.argv[2] if len(sys.argv) > 2 else "/tmp/membranes-figures"
     os.makedirs(out, exist_ok=True)
+    problem_figure(out)
     dual_mesh_figure(membranes, out)
     fields_figure(membranes, out)
     adaptive_mesh_figure(membranes, out)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Every table and figure of README.md, doc/tutorial.md and
+# Every table and figure of README.md, doc/tutorial.md, doc/advanced.md and
 # benchmarks/README.md, made anew from the built program.
 #
 #   doc/make_results.sh [path/to/membranes] [work-dir]
@@ -13,13 +13,15 @@
 #
 # of the documents (doc/results.py splice), and the figures to doc/images/.
 # SECTIONS in the environment chooses what to make (default: all of
-# "readme tutorial benchmarks"); "benchmarks" runs every script of
+# "benchmarks readme tutorial"); "benchmarks" runs every script of
 # benchmarks/ (about half an hour on two cores, up to 9 GB of memory for
-# mpi_scaling.sh) and the tutorial quotes some of their tables, so it comes
-# first. BLOCKS in the environment limits the section benchmarks to the
-# blocks of benchmarks/README.md it names (e.g. BLOCKS="solver-cost
-# flux-estimator"); the others, and the tutorial's quotes of them, are left
-# as they are. The peer benchmark needs python3-dolfinx; without it its table is
+# mpi_scaling.sh) and the section tutorial summarizes some of their runs, so
+# it comes first. The section tutorial writes doc/tutorial.md,
+# doc/advanced.md (the identities of the flux reconstruction) and the
+# comparison of exact and balanced stopping in benchmarks/README.md. BLOCKS
+# in the environment limits the section benchmarks to the blocks of
+# benchmarks/README.md it names (e.g. BLOCKS="solver-cost flux-estimator");
+# the others are left as they are. The peer benchmark needs python3-dolfinx; without it its table is
 # left as it is and the script says so. The figures need python3-matplotlib.
 #
 # A benchmark that misses one of its targets exits with status 1; its table
@@ -180,13 +182,6 @@ for section in $sections; do
       "$work/own-scene/report.csv=adaptive" \
       "$work/own-scene-uniform/report.csv=uniform" >"$work/blocks/own-scene.table"
     block README.md own-scene <"$work/blocks/own-scene.table"
-
-    # The table and the figures of the adaptive section come from
-    # benchmarks/adaptivity.sh (section benchmarks).
-    commands=("benchmarks/adaptivity.sh $membranes $work/adaptivity")
-    run $python doc/results.py adaptivity "$work/adaptivity" \
-      >"$work/blocks/adaptivity.table"
-    block README.md adaptivity <"$work/blocks/adaptivity.table"
     ;;
 
   tutorial)
@@ -242,19 +237,15 @@ for section in $sections; do
     run $python doc/results.py balanced "${arguments[@]}" \
       >"$work/blocks/balanced.table"
     { machine; echo; cat "$work/blocks/balanced.table"; } |
-      block doc/tutorial.md balanced
+      block benchmarks/README.md balanced
 
-    # Tables quoted from the benchmarks (section benchmarks).
+    # From the runs of the benchmarks (section benchmarks).
     commands=()
     run $python doc/results.py flux-identities \
       "$work/flux_estimator/case-m-q1/report.csv=case M, Q1" \
       "$work/flux_estimator/case-m-p1/report.csv=case M, P1" \
       >"$work/blocks/flux-identities.table"
-    block doc/tutorial.md flux-identities <"$work/blocks/flux-identities.table"
-    for script in flux_estimator flux_effectivity; do
-      commands=("benchmarks/$script.sh $membranes $work/$script")
-      block doc/tutorial.md "${script//_/-}" <"$work/$script/table.md"
-    done
+    block doc/advanced.md flux-identities <"$work/blocks/flux-identities.table"
     commands=("benchmarks/adaptivity.sh $membranes $work/adaptivity")
     run $python doc/results.py adaptivity "$work/adaptivity" \
       >"$work/blocks/adaptivity.table"
@@ -265,10 +256,10 @@ for section in $sections; do
       >"$work/figures.log"
     mapfile -t drawn < <(sed -n 's/^\$ //p' "$work/figures.log")
     commands+=("${drawn[@]}")
-    for image in dual-mesh case-m-fields slit-adaptive-mesh; do
+    for image in membranes dual-mesh case-m-fields slit-adaptive-mesh; do
       figure "$work/figures/$image.png" "$image.png"
     done
-    echo "The three figures of meshes and fields: dual-mesh.png, case-m-fields.png, slit-adaptive-mesh.png." |
+    echo "The figures membranes.png (from the exact solution of case M, no run), dual-mesh.png, case-m-fields.png and slit-adaptive-mesh.png." |
       block doc/tutorial.md figures
     ;;
 
