@@ -1,3 +1,4 @@
+#include <Epetra_CrsMatrix.h>
 #include <algorithm>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -152,10 +153,20 @@ namespace membranes
     candidates.erase(std::unique(candidates.begin(), candidates.end()),
                      candidates.end());
 
-    const auto row_l1_norm = [&](const types::global_dof_index row) {
+    // The row of the assembled operator, read in place (deal.II's row
+    // iterators copy every row they visit).
+    const Epetra_CrsMatrix &epetra = matrix.trilinos_matrix();
+    const auto row_l1_norm         = [&](const types::global_dof_index row) {
+      int     n_entries;
+      double *values;
+      int    *columns;
+      epetra.ExtractMyRowView(epetra.LRID(static_cast<long long>(row)),
+                              n_entries,
+                              values,
+                              columns);
       double norm = 0;
-      for (auto entry = matrix.begin(row); entry != matrix.end(row); ++entry)
-        norm += std::abs(entry->value());
+      for (int k = 0; k < n_entries; ++k)
+        norm += std::abs(values[k]);
       return norm;
     };
 
