@@ -55,14 +55,13 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::setup(const DoFHandler<dim> &dof_handler,
-                            const IndexSet        &locally_owned_dofs,
-                            const IndexSet        &locally_relevant_dofs,
-                            const DiscreteAction<dim> &)
+  CoupledSystem<dim>::setup(const MeshOperator<dim> &mesh_operator)
   {
-    this->dof_handler           = &dof_handler;
-    this->locally_owned_dofs    = locally_owned_dofs;
-    this->locally_relevant_dofs = locally_relevant_dofs;
+    this->mesh                         = &mesh_operator;
+    const DoFHandler<dim> &dof_handler = mesh_operator.get_dof_handler();
+    const IndexSet &locally_owned_dofs = mesh_operator.locally_owned_dofs();
+    const IndexSet &locally_relevant_dofs =
+      mesh_operator.locally_relevant_dofs();
 
     // The contact constraint u1(a) = u2(a) only ever couples DoFs of
     // vertices that share a cell, so the full coupling of all DoFs of a
@@ -97,25 +96,15 @@ namespace membranes
 
 
   template <int dim>
-  void
-  CoupledSystem<dim>::prepare(const VectorType &,
-                              const LinearTolerances &,
-                              ActiveSetStatistics &)
-  {}
-
-
-
-  template <int dim>
   typename CoupledSystem<dim>::VectorType
-  CoupledSystem<dim>::tension_scaling(const DiscreteAction<dim> &action,
-                                      const IndexSet &active_set) const
+  CoupledSystem<dim>::tension_scaling(const IndexSet &active_set) const
   {
     const double M       = this->data.mu[0] + this->data.mu[1];
     VectorType   scaling = tension;
-    for (const auto &dofs : action.locally_relevant_vertices())
+    for (const auto &dofs : this->mesh->locally_relevant_vertices())
       if (active_set.is_element(dofs[0]))
         for (const auto dof : dofs)
-          if (locally_owned_dofs.is_element(dof))
+          if (this->mesh->locally_owned_dofs().is_element(dof))
             scaling[dof] = M;
     for (auto &entry : scaling)
       entry = 1 / std::sqrt(entry);
@@ -127,18 +116,18 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::solve(const DiscreteAction<dim> &action,
-                            const IndexSet            &active_set,
-                            VectorType                &solution,
-                            const LinearTolerances    &tolerances,
-                            ActiveSetStatistics       &statistics)
+  CoupledSystem<dim>::solve(const IndexSet         &active_set,
+                            VectorType             &solution,
+                            const LinearTolerances &tolerances,
+                            ActiveSetStatistics    &statistics)
   {
-    VectorType scaling;
+    const MeshOperator<dim> &mesh = *this->mesh;
+    VectorType               scaling;
     {
       TimerOutput::Scope scope(this->timer, "assembly");
       constraints.clear();
-      constraints.reinit(locally_relevant_dofs);
-      for (const auto &dofs : action.locally_relevant_vertices())
+      constraints.reinit(mesh.locally_relevant_dofs());
+      for (const auto &dofs : mesh.locally_relevant_vertices())
         if (active_set.is_element(dofs[0]))
           {
             constraints.add_line(dofs[0]);
@@ -151,11 +140,11 @@ namespace membranes
       this->system_matrix = 0;
       this->system_rhs    = 0;
       CellSystem<dim> cell_system(this->discretization, this->data);
-      for (const auto &cell : dof_handler->active_cell_iterators())
+      for (const auto &cell : mesh.get_dof_handler().active_cell_iterators())
         if (cell->is_locally_owned())
           {
             cell_system.reinit_operator(cell);
-            cell_system.set_loads(action.cell_loads(cell));
+            cell_system.set_loads(mesh.cell_loads(cell));
             constraints.distribute_local_to_global(cell_system.matrix,
                                                    cell_system.rhs,
                                                    cell_system.dof_indices,
@@ -171,9 +160,9 @@ namespace membranes
       // Σ_a (r_W,a² / μ̄ + r_S,a² / (μ1 + μ2)) (sums over active vertices
       // only r_S), so one bound on it bounds r_S and r_W each on its own
       // scale.
-      scaling = tension_scaling(action, active_set);
-      VectorType ghosted_scaling(locally_owned_dofs,
-                                 locally_relevant_dofs,
+      scaling = tension_scaling(active_set);
+      VectorType ghosted_scaling(mesh.locally_owned_dofs(),
+                                 mesh.locally_relevant_dofs(),
                                  this->mpi_communicator);
       ghosted_scaling = scaling;
       scale_symmetrically(this->system_matrix, ghosted_scaling);

@@ -102,21 +102,19 @@ namespace membranes
                            mpi_communicator)
     , sum_boundary_values(combine_boundary_values(data, data.mu[0], data.mu[1]))
     , difference_boundary_values(combine_boundary_values(data, 1., -1.))
-    , action(nullptr)
+    , sum_solved(false)
   {}
 
 
 
   template <int dim>
   void
-  DecoupledSystem<dim>::setup(const DoFHandler<dim> &dof_handler,
-                              const IndexSet &,
-                              const IndexSet            &locally_relevant_dofs,
-                              const DiscreteAction<dim> &action)
+  DecoupledSystem<dim>::setup(const MeshOperator<dim> &mesh_operator)
   {
-    this->dof_handler           = &dof_handler;
-    this->action                = &action;
-    this->locally_relevant_dofs = locally_relevant_dofs;
+    this->mesh                         = &mesh_operator;
+    const DoFHandler<dim> &dof_handler = mesh_operator.get_dof_handler();
+    const IndexSet        &locally_relevant_dofs =
+      mesh_operator.locally_relevant_dofs();
     scalar_dof_handler.reinit(dof_handler.get_triangulation());
     scalar_dof_handler.distribute_dofs(
       this->discretization.fe->base_element(0));
@@ -177,6 +175,7 @@ namespace membranes
     difference_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     sum.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     difference.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
+    sum_solved = false;
   }
 
 
@@ -200,7 +199,7 @@ namespace membranes
     sum_rhs        = 0;
     difference_rhs = 0;
     run_on_cells<CellContribution>(
-      *dof_handler,
+      this->mesh->get_dof_handler(),
       [&]() {
         return std::make_unique<CellSystem<dim>>(this->discretization,
                                                  this->data);
@@ -212,7 +211,7 @@ namespace membranes
         if (!cell->is_locally_owned())
           return;
         cell_system.reinit_operator(cell);
-        cell_system.set_loads(action->cell_loads(cell));
+        cell_system.set_loads(this->mesh->cell_loads(cell));
         contribution.scalar_dof_indices.resize(cell_system.laplace_matrix.m());
         cell_of(scalar_dof_handler, cell)
           ->get_dof_indices(contribution.scalar_dof_indices);
@@ -251,9 +250,9 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::prepare(const VectorType       &solution,
-                                const LinearTolerances &tolerances,
-                                ActiveSetStatistics    &statistics)
+  DecoupledSystem<dim>::solve_sum(const VectorType       &solution,
+                                  const LinearTolerances &tolerances,
+                                  ActiveSetStatistics    &statistics)
   {
     {
       TimerOutput::Scope scope(this->timer, "assembly");
@@ -279,20 +278,23 @@ namespace membranes
                               sum,
                               tolerances.sum,
                               statistics);
+    sum_solved = true;
   }
 
 
 
   template <int dim>
   void
-  DecoupledSystem<dim>::solve(const DiscreteAction<dim> &,
-                              const IndexSet         &active_set,
+  DecoupledSystem<dim>::solve(const IndexSet         &active_set,
                               VectorType             &solution,
                               const LinearTolerances &tolerances,
                               ActiveSetStatistics    &statistics)
   {
-    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double       M = mu1 + mu2;
+    if (!sum_solved)
+      solve_sum(solution, tolerances, statistics);
+    const IndexSet &locally_relevant_dofs = this->mesh->locally_relevant_dofs();
+    const double    mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double    M = mu1 + mu2;
     TimerOutput::Scope assembly(this->timer, "assembly");
 
     // The scalar DoFs of the active vertices; W = 0 there.

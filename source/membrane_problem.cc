@@ -23,6 +23,8 @@ namespace membranes
     , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
                                             mpi_communicator))
     , dof_handler(*triangulation)
+    , mesh_operator(discretization, data)
+    , active_set(parameters.solver, discretization, data, mpi_communicator)
     , action(discretization, data)
     , active_set_solver(parameters.solver,
                         discretization,
@@ -133,7 +135,9 @@ namespace membranes
 
   /**
    * DoFs of (u1, u2), the index sets of the step-40 layout, the hanging node
-   * constraints, the vertices of the dual mesh and the solver's matrix.
+   * constraints, and the operator of the mesh (MeshOperator: the Laplacian,
+   * the loads, the vertices of the dual mesh), which the discrete action and
+   * the solver's systems read.
    */
   template <int dim>
   void
@@ -149,15 +153,13 @@ namespace membranes
                                             hanging_node_constraints);
     hanging_node_constraints.close();
 
-    action.reinit(dof_handler,
-                  hanging_node_constraints,
-                  locally_owned_dofs,
-                  locally_relevant_dofs,
-                  mpi_communicator);
-    active_set_solver.setup(dof_handler,
-                            locally_owned_dofs,
-                            locally_relevant_dofs,
-                            action);
+    mesh_operator.reinit(dof_handler,
+                         hanging_node_constraints,
+                         locally_owned_dofs,
+                         locally_relevant_dofs,
+                         mpi_communicator);
+    action.reinit(mesh_operator);
+    active_set_solver.setup(mesh_operator);
 
     solution.reinit(locally_owned_dofs, mpi_communicator);
     ghosted_solution.reinit(locally_owned_dofs,
@@ -181,8 +183,8 @@ namespace membranes
   {
     if (previous_mesh_vectors.empty())
       {
-        solution   = 0;
-        active_set = IndexSet(dof_handler.n_dofs());
+        solution = 0;
+        active_set.reinit(mesh_operator);
         return;
       }
 
@@ -205,8 +207,7 @@ namespace membranes
     solution         = interpolated[0];
     ghosted_solution = interpolated[0];
     lambda_h         = interpolated[1];
-    active_set =
-      active_set_solver.initial_active_set(action, ghosted_solution, lambda_h);
+    active_set.reinit(mesh_operator, ghosted_solution, lambda_h);
   }
 
 
@@ -255,8 +256,7 @@ namespace membranes
     record.kkt_residual           = statistics.kkt_residual;
     record.linearization_estimate = statistics.linearization_estimate;
     record.algebraic_estimate     = statistics.algebraic_estimate;
-    record.active_vertices =
-      Utilities::MPI::sum(active_set.n_elements(), mpi_communicator);
+    record.active_vertices        = active_set.n_active_vertices();
   }
 
 
@@ -288,40 +288,22 @@ namespace membranes
     compute_lambda_h();
     action.set_lambda_h(lambda_h);
 
-    double      min_w      = std::numeric_limits<double>::max();
-    double      min_lambda = min_w, prop12 = 0, product = 0;
-    const auto &vertices = action.vertices();
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const auto  &a = vertices[k];
-        const double w =
-          ghosted_solution[a.dof[0]] - ghosted_solution[a.dof[1]];
-        const double lambda = action.lambda(k);
-        min_w               = std::min(min_w, w);
-        min_lambda          = std::min(min_lambda, lambda);
-        prop12              = std::max(prop12,
-                          std::abs(action.lambda_from_membrane(0, k) -
-                                   action.lambda_from_membrane(1, k)) *
-                            a.dual_cell_measure);
-        product = std::max(product, std::abs(lambda * a.dual_cell_measure * w));
-      }
-    const double force_scale =
+    const KKTDefects defects = active_set.kkt_defects(action, ghosted_solution);
+    const double     force_scale =
       std::max(action.force_scale(), std::numeric_limits<double>::min());
-    const double u_scale = std::max(ghosted_solution.linfty_norm(),
-                                    std::numeric_limits<double>::min());
+    const double u_scale = displacement_scale(ghosted_solution);
     // The active set lives on V_h only: no hanging vertex is ever active.
     unsigned int hanging_active = 0;
-    for (const auto dof : active_set)
+    for (const auto dof : active_set.locally_owned())
       if (hanging_node_constraints.is_constrained(dof))
         ++hanging_active;
     record.hanging_active_vertices =
       Utilities::MPI::sum(hanging_active, mpi_communicator);
-    record.min_w      = Utilities::MPI::min(min_w, mpi_communicator);
-    record.min_lambda = Utilities::MPI::min(min_lambda, mpi_communicator);
-    record.prop12_defect =
-      Utilities::MPI::max(prop12, mpi_communicator) / force_scale;
+    record.min_w         = defects.min_gap;
+    record.min_lambda    = defects.min_lambda;
+    record.prop12_defect = defects.sum_equilibrium / force_scale;
     record.complementarity_defect =
-      Utilities::MPI::max(product, mpi_communicator) / (force_scale * u_scale);
+      defects.complementarity / (force_scale * u_scale);
   }
 
 

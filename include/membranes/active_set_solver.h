@@ -3,18 +3,16 @@
 
 #include <array>
 #include <deal.II/base/conditional_ostream.h>
-#include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
-#include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <membranes/active_set.h>
 #include <membranes/active_set_system.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
+#include <membranes/mesh_operator.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <memory>
-#include <optional>
-#include <vector>
 
 namespace membranes
 {
@@ -37,197 +35,23 @@ namespace membranes
 
 
   /**
-   * A vertex whose status the active set method wants to change: its u1 DoF
-   * and by how much its test is violated, in units of the band of
-   * indifference (see ActiveSetSolver), so at least 1.
-   */
-  struct StatusChange
-  {
-    types::global_dof_index dof;
-    double                  violation;
-
-    /** For Utilities::MPI::all_gather(). */
-    template <class Archive>
-    void
-    serialize(Archive &archive, const unsigned int)
-    {
-      archive &dof &violation;
-    }
-  };
-
-
-
-  /**
-   * The active sets the active set method has visited on one mesh, and the
-   * remedy against cycling.
-   *
-   * The plain update changes the status of every vertex whose test is
-   * violated. For an M-matrix (non-obtuse meshes) this converges
-   * monotonically, but in general the primal-dual active set method, a
-   * semismooth Newton method for the complementarity problem, may cycle:
-   * return to an active set it has already visited, and go round for ever.
-   * Each update is therefore checked against all active sets visited on
-   * the current mesh (the initial one included). When it would return to
-   * one of them, the update is restricted to the vertices with the largest
-   * violations: on the r-th cycle detected on this mesh to ⌈n / 2^r⌉ of the
-   * n vertices that want to change; if that set was visited too, r is
-   * raised again. Once the share is down to one vertex, the method
-   * continues on this mesh with Murty's least-index rule: change only the
-   * wanted vertex of least DoF index. That rule terminates for every linear
-   * complementarity problem with a P-matrix (K. G. Murty, Note on a
-   * Bard-type scheme for solving the complementarity problem, Opsearch 11,
-   * 1974), and ours has one: eliminating the displacements leaves the Schur
-   * complement of the symmetric positive definite system on the contact
-   * vertices, which is symmetric positive definite. The halving can only happen
-   * log2(n) times, so the method terminates on every mesh; a cycle costs
-   * iterations, not convergence.
-   *
-   * Under MPI each process keeps the locally owned part of the sets; the
-   * comparisons and the choice of vertices are global.
-   */
-  class ActiveSetHistory
-  {
-  public:
-    explicit ActiveSetHistory(const MPI_Comm mpi_communicator);
-
-    /** Forget all, and start a new mesh at @p initial_active_set. */
-    void
-    restart(const IndexSet &initial_active_set);
-
-    /** What one update did. */
-    struct Step
-    {
-      /** The next active set (locally owned part). */
-      IndexSet active_set;
-      /** How many vertices wanted to change, and how many did. */
-      types::global_dof_index wanted, changed;
-      /**
-       * The number of the visited set (0 for the initial one, k for the
-       * set of iteration k + 1) that the plain update would have
-       * returned to, if a cycle was detected.
-       */
-      std::optional<unsigned int> cycle_to;
-      /** Whether the update followed Murty's least-index rule. */
-      bool least_index_rule;
-    };
-
-    /**
-     * The active set after @p active_set (the last one visited), changed
-     * at the locally owned vertices @p changes or, if that would close a
-     * cycle, at the part of them that the remedy allows. The result is
-     * recorded as visited.
-     */
-    Step
-    next(const IndexSet &active_set, const std::vector<StatusChange> &changes);
-
-    /** Cycles detected since restart(). */
-    unsigned int
-    cycles() const;
-
-  private:
-    /** The number of the visited set equal to @p set (on all processes). */
-    std::optional<unsigned int>
-    find(const IndexSet &set) const;
-
-    const MPI_Comm        mpi_communicator;
-    std::vector<IndexSet> visited;
-    unsigned int          n_cycles;
-    bool                  least_index_rule;
-  };
-
-
-
-  /**
    * The primal-dual active set method (a semismooth Newton method) for the
    * discrete variational inequality (3.4), as in deal.II's step-41 but for
    * the pair (u1, u2).
    *
-   * With W_a = u1h(a) − u2h(a) and the nodal multiplier Λ_a = λ_a of (4.5),
-   * the active set is
-   *
-   *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a,
-   *
-   * where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2) is the tension of the
-   * obstacle problem for w = u1 − u2, DecoupledSystem). Each iteration
-   * solves the
-   * linear problem W_a = 0 on A, Λ_a = 0 off A (ActiveSetSystem): on the
-   * coupled pair (CoupledSystem, `Solver/Method = coupled`) or on the sum
-   * and the difference of the membranes (DecoupledSystem, `decoupled`).
-   * Both give the same iterate; λ_a, the next active set and the KKT
-   * residual are computed from it in the same way.
-   *
-   * <b>Decisions relative to the data.</b> In the units of the data, the
-   * test reads λ̂_a − Ŵ_a > 0 with
-   *
-   *   λ̂_a = λ_a / (c_a U_∞),   Ŵ_a = W_a / U_∞,   U_∞ = max|U|,
-   *
-   * both unchanged when the loads and g are multiplied by a factor, or μ1
-   * and μ2 (with the loads) by a factor. (c_a U_∞ d_a = μ̄ ∫|∇φ_a|² U_∞ is
-   * the size of the forces of the obstacle problem for w at a.) After a
-   * solve, W_a = 0 on A and λ_a = 0 off A, up to round-off, so the test
-   * keeps an active vertex iff λ_a > 0 and activates an inactive one iff
-   * W_a < 0; c_a only matters for the initial active set of a mesh. Where
-   * both are zero in exact arithmetic (a degenerate vertex: the membranes
-   * touch without pressing on each other), the sign of the test is the
-   * sign of round-off, a vertex may flip at every iteration, and the plain
-   * method cycles. Each sign is therefore read with a band of indifference
-   * ε = `Tolerance`:
-   * - an active vertex is released iff λ̂_a < −ε,
-   * - an inactive vertex is activated iff Ŵ_a < −ε,
-   * - every other vertex keeps its status (hysteresis).
-   * The band is about that of the KKT residual: a vertex kept in it adds at
-   * most about ε to its dual (−λ_a d_a / F^w_∞, F^w_∞ ≥ μ̄ ∫|∇φ_a|² U_∞) or
-   * primal (−W_a / U_∞) feasibility part, so either status is an acceptable
-   * answer for it. λ_a is DiscreteAction::lambda(), the multiplier of the
-   * obstacle problem for w: its rounding and algebraic errors are those of
-   * forces of tension μ̄, as the band is, whatever the tension ratio.
-   *
-   * <b>The next active set, predicted.</b> Where strict complementarity
-   * fails at the free boundary (λ and u1 − u2 both vanish there, as in
-   * parameters/degenerate-free-boundary.prm), the discrete contact zone of
-   * a finer mesh reaches several layers of vertices beyond the one
-   * interpolated from the coarser mesh: with u1 − u2 ~ dist³, the O(h²)
-   * errors of the coarse solution move its edge by O(h^{2/3}), i.e. by
-   * O(h^{−1/3}) layers (measured: the contact radius 0.4774, 0.4853,
-   * 0.4904 for R = 1/2 on 33 282, 132 098, 526 338 DoFs, the gap shrinking
-   * by 1.53 ≈ 2^{2/3} per refinement). The plain update then overshoots:
-   * the first solve penetrates over a band wider than the missing one, all
-   * of it is activated, and the surplus is released one layer per
-   * iteration, because only its outer rim feels the free vertices beyond
-   * (inside the band the load presses the membranes together, so λ_a > 0
-   * there), and the count grew with refinement (3 4 3 5 6 6 iterations on
-   * cycles 1 to 6 of that scene). So when the test wants changes, the next
-   * active set is the test applied not to the iterate itself but to a
-   * prediction from it: n_prediction_sweeps sweeps of projected Jacobi on
-   * the obstacle problem for w with s fixed,
-   *
-   *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
-   *
-   * ‖A_a‖₁ = Σ_b |A_ab| the l1 norm of the row of a in the condensed
-   * Laplacian (one product with the operator of DiscreteAction per sweep).
-   * Where A is an M-matrix, ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and
-   * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
-   * dominant, hence positive semidefinite, so the sweeps never increase
-   * the energy norm of the error, on any mesh; plain Jacobi diverged on
-   * the curved, locally refined cells of the disk, and l1-Jacobi (the
-   * divisor ‖A_a‖₁) needed more sweeps (4 iterations on Q1 where this
-   * needs 3). Each sweep carries the contact
-   * information one layer further: penetrated vertices are clamped and
-   * lift their neighbours, active vertices pulled apart are released with
-   * the ones behind them. Where the predicted test is within the band of
-   * indifference, the prediction has nothing to say and the plain test on
-   * the iterate decides: a vertex that the solves keep penetrating by a
-   * few ε is clamped by the sweeps to a contact force within the band, and
-   * without the plain test it would stay inactive until the prediction
-   * wants no change at all (an extra iteration on the finest meshes of a
-   * degenerate free boundary). The prediction only proposes; the solve of
-   * the next iteration and the plain test decide, and convergence is
-   * judged on the iterate alone. If the prediction wants no change, or once a
-   * cycle has been detected on the mesh, the plain update is used, so that the
-   * remedy against cycling below works on the plain test as before.
+   * The loop of solve() is that of step-41: solve the linear problem of the
+   * active set A (ActiveSetSystem: W_a = u1h(a) − u2h(a) = 0 on A, λ_a = 0
+   * off A; on the coupled pair, CoupledSystem, `Solver/Method = coupled`,
+   * or on the sum and the difference of the membranes, DecoupledSystem,
+   * `decoupled`; both give the same iterate), compute λ_a by (4.5)
+   * (DiscreteAction), test the KKT conditions, and move to the next active
+   * set (ActiveSet, which holds the test Λ_a − c_a W_a > 0, its band of
+   * indifference, the prediction of the next set and the remedy against
+   * cycling).
    *
    * <b>Convergence.</b> The iteration stops when no vertex wants to change
-   * and the relative KKT residual (kkt_residual()) is at most `Tolerance`.
+   * and the relative KKT residual (KKTDefects::relative_residual()) is at
+   * most `Tolerance`.
    * The linear solves are tied to that test (LinearTolerances): the problem
    * for s and the obstacle problem for w each stop at the residual norm
    * `Tolerance` times their own force scale, F_∞ and F^w_∞ of
@@ -243,8 +67,7 @@ namespace membranes
    * set is solved again with residuals settled_tightening times smaller,
    * from the same AMG hierarchy; if that does not decrease the residual, or
    * at `Max active set iterations`, solve() throws ActiveSetNotConverged
-   * with the residual reached. Cycling is detected and remedied by
-   * ActiveSetHistory.
+   * with the residual reached.
    *
    * <b>Balanced stopping</b> (`Solver/Stopping = balanced`). On a mesh whose
    * discretization error η̃ in the energy norm |||v|||² = Σ_i μ_i |v_i|²_{H1}
@@ -279,15 +102,13 @@ namespace membranes
    *   1/h, for oscillating ones: the CG tolerance errs on the safe side.
    * - η_lin measures how far the active set is from the right one: the
    *   energy norm of one sweep of the projected Jacobi relaxation of the
-   *   prediction below, the correction δ of w that the wanted changes ask
-   *   for: δ_a = −W_a on an inactive vertex with W_a < 0, and
-   *   δ_a = 2 λ_a⁻ d_a / (μ̄ ‖A_a‖₁) on an active one with λ_a < 0. Moving w by
-   *   δ with s fixed moves (u1, u2) by (μ2 δ, −μ1 δ)/(μ1 + μ2), of energy
-   *   μ̄ δᵀAδ ≤ μ̄ Σ_a ‖A_a‖₁ δ_a² (diag(‖A_a‖₁) − A is positive
-   *   semidefinite), so
-   *     η_lin = (μ̄ Σ_a ‖A_a‖₁ δ_a²)^{1/2},
-   *   local to the vertices that want to change (an estimate of the next
-   *   step, not a bound of the whole linearization error: the next solve
+   *   prediction of ActiveSet, the correction δ of w that the wanted changes
+   * ask for: δ_a = −W_a on an inactive vertex with W_a < 0, and δ_a = 2 λ_a⁻
+   * d_a / (μ̄ ‖A_a‖₁) on an active one with λ_a < 0. Moving w by δ with s fixed
+   * moves (u1, u2) by (μ2 δ, −μ1 δ)/(μ1 + μ2), of energy μ̄ δᵀAδ ≤ μ̄ Σ_a ‖A_a‖₁
+   * δ_a² (diag(‖A_a‖₁) − A is positive semidefinite), so η_lin = (μ̄ Σ_a ‖A_a‖₁
+   * δ_a²)^{1/2}, local to the vertices that want to change (an estimate of the
+   * next step, not a bound of the whole linearization error: the next solve
    *   spreads the correction).
    * On the first mesh nothing is expected (η̃ = 0 is passed) and the method
    * stops exactly. With `exact` (the default) nothing of this is evaluated.
@@ -310,76 +131,44 @@ namespace membranes
                     TimerOutput               &timer,
                     const MPI_Comm             mpi_communicator);
 
-    /** The linear systems for the current mesh (ActiveSetSystem::setup()). */
+    /** The linear systems for the mesh of @p mesh_operator. */
     void
-    setup(const DoFHandler<dim>     &dof_handler,
-          const IndexSet            &locally_owned_dofs,
-          const IndexSet            &locally_relevant_dofs,
-          const DiscreteAction<dim> &action);
+    setup(const MeshOperator<dim> &mesh_operator);
 
     /**
      * Run the active set method from the initial guess @p solution (locally
-     * owned entries) and the initial active set @p active_set (u1 DoFs of
-     * active vertices). On return both hold the converged iterate, and
-     * @p action holds λ_a for it; if ActiveSetNotConverged is thrown, the
-     * last iterate. @p expected_error is the discretization error η̃
-     * expected on this mesh for balanced stopping, 0 if none is known.
+     * owned entries) and the initial @p active_set. On return both hold the
+     * converged iterate, and @p action holds λ_a for it; if
+     * ActiveSetNotConverged is thrown, the last iterate. @p expected_error
+     * is the discretization error η̃ expected on this mesh for balanced
+     * stopping, 0 if none is known.
      */
     Statistics
     solve(DiscreteAction<dim> &action,
           VectorType          &solution,
-          IndexSet            &active_set,
+          ActiveSet<dim>      &active_set,
           const double         expected_error = 0);
 
-    /**
-     * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
-     * mesh's solution and λ_h interpolated onto it (nested iteration). A
-     * vertex where both |λ̂_a| ≤ ε and |Ŵ_a| ≤ ε is degenerate up to
-     * round-off; it starts inactive, as every vertex of the first mesh does.
-     */
-    IndexSet
-    initial_active_set(const DiscreteAction<dim> &action,
-                       const VectorType          &ghosted_solution,
-                       const VectorType          &ghosted_lambda_h) const;
-
-    /**
-     * The relative KKT residual of an iterate, the largest of the defects
-     * of the two problems of DecoupledSystem, each on its own scale
-     * (F_∞, F^w_∞ of DiscreteAction, U_∞ = max|U|):
-     * - equilibrium of s: max |λ_1a − λ_2a| d_a / F_∞ (Prop. 12);
-     * - equilibrium of w: max |λ_a d_a| / F^w_∞ on inactive vertices;
-     * - primal feasibility: max(−W_a)⁺ / U_∞;
-     * - dual feasibility: max(−λ_a d_a)⁺ / F^w_∞;
-     * - complementarity: max |λ_a d_a W_a| / (F^w_∞ U_∞).
-     * All are maxima over the vertices, so none grows with the size of the
-     * mesh, and all are unchanged when the data are scaled or the
-     * membranes swap roles.
-     */
-    double
-    kkt_residual(const DiscreteAction<dim> &action,
-                 const VectorType          &ghosted_solution,
-                 const IndexSet            &active_set) const;
-
   private:
-    /** The scales of an iterate that decisions and residuals refer to. */
-    struct Scales
+    /** Where the method stands in its stopping test on one mesh. */
+    struct Stopping
     {
-      double force;         ///< F_∞ of DiscreteAction.
-      double contact_force; ///< F^w_∞ of DiscreteAction.
-      double displacement;  ///< U_∞ = max|U|.
+      /** Balanced stopping, and γ η̃. */
+      bool   balanced;
+      double balance;
+      /** By how much the residuals of the linear solves are made smaller. */
+      double tightening;
+      /**
+       * The residual of the last iteration in which the active set did not
+       * change: it has to decrease while the linear solves refine it.
+       */
+      double settled_residual;
+      /**
+       * F_∞ and F^w_∞ (DiscreteAction) of the iterate the active set was
+       * last chosen on, the prediction if ActiveSet::update() made one.
+       */
+      std::array<double, 2> force_scales;
     };
-
-    Scales
-    scales(const DiscreteAction<dim> &action,
-           const VectorType          &ghosted_solution) const;
-
-    /**
-     * Sweeps of projected Jacobi in predicted_changes(): more layers than
-     * the free boundary moves between two nested meshes (measured: 3 to 6
-     * on the degenerate scene; 10 sweeps left one iteration more on its
-     * last two cycles, 40 none).
-     */
-    static constexpr unsigned int n_prediction_sweeps = 40;
 
     /**
      * How much smaller the residuals of the linear solves are made when
@@ -387,52 +176,75 @@ namespace membranes
      */
     static constexpr double settled_tightening = 100;
 
-    /**
-     * The changes of the active set after the iterate @p solution (locally
-     * owned entries) whose plain test wants @p changes: those of
-     * predicted_changes(), unless a cycle has been detected on this mesh or
-     * the prediction wants none; then @p changes.
+    /** The stopping test of a mesh whose expected error is @p expected_error.
      */
-    std::vector<StatusChange>
-    next_changes(DiscreteAction<dim>             &action,
-                 const VectorType                &solution,
-                 const IndexSet                  &active_set,
-                 const std::vector<StatusChange> &changes) const;
+    Stopping
+    start(const double expected_error) const;
 
     /**
-     * The locally owned vertices whose status in @p active_set the test
-     * Λ_a − c_a W_a > 0 (with the band of indifference) wants to change on
-     * the iterate predicted from @p solution by n_prediction_sweeps sweeps
-     * of projected Jacobi (see the class documentation); at the vertices
-     * where that test is within the band, those of @p plain_changes, the
-     * changes the plain test wants on @p solution itself. Leaves in
-     * @p action the λ_a of the prediction.
+     * λ_a of the iterate @p solution into @p action, @p solution into
+     * @p ghosted_solution, and its force scales into @p stopping.
      */
-    std::vector<StatusChange>
-    predicted_changes(DiscreteAction<dim>             &action,
-                      const VectorType                &solution,
-                      const IndexSet                  &active_set,
-                      const std::vector<StatusChange> &plain_changes) const;
+    void
+    compute_action(DiscreteAction<dim> &action,
+                   const VectorType    &solution,
+                   VectorType          &ghosted_solution,
+                   Stopping            &stopping) const;
 
     /**
-     * @p active_set (owned vertices) extended to the locally relevant
-     * vertices of @p action by a ghost exchange: the owner of each vertex
-     * decides, every process that shares a cell with it learns the
-     * decision.
+     * Move @p active_set on after the iterate @p solution of iteration
+     * @p iteration, whose test wants @p changes (ActiveSet::update()); say
+     * so if a cycle was remedied, and take the force scales of the
+     * prediction into @p stopping.
      */
-    IndexSet
-    locally_relevant_active_set(const DiscreteAction<dim> &action,
-                                const IndexSet            &active_set) const;
+    void
+    update(ActiveSet<dim>                  &active_set,
+           const VectorType                &solution,
+           const std::vector<StatusChange> &changes,
+           const unsigned int               iteration,
+           Stopping                        &stopping) const;
 
     /**
-     * The locally owned vertices of @p action whose status in
-     * @p active_set the test wants to change, outside the band of
-     * indifference (see the class documentation).
+     * The residual norms at which the linear solves stop: those that the
+     * KKT test allows, on the force scales of @p stopping (a bound on the
+     * Euclidean norm bounds every nodal residual, so an iterate on the
+     * right active set meets the equilibrium, dual feasibility and
+     * complementarity parts of the test by construction), made smaller by
+     * its tightening; with balanced stopping at least those of an
+     * algebraic error of γ η̃ / 2 in the energy norm.
      */
-    std::vector<StatusChange>
-    wanted_changes(const DiscreteAction<dim> &action,
-                   const VectorType          &ghosted_solution,
-                   const IndexSet            &active_set) const;
+    LinearTolerances
+    linear_tolerances(const Stopping &stopping) const;
+
+    /**
+     * The KKT residual of the iterate @p solution with λ_a in @p action and,
+     * with balanced stopping, η_lin and η_alg, into @p statistics.
+     */
+    void
+    evaluate(const DiscreteAction<dim> &action,
+             const VectorType          &solution,
+             const ActiveSet<dim>      &active_set,
+             const Stopping            &stopping,
+             Statistics                &statistics) const;
+
+    /**
+     * Whether the method stops after the iteration of @p statistics, whose
+     * test wants @p n_changes changes; throws ActiveSetNotConverged if it
+     * stops without convergence. Tightens the linear solves of @p stopping
+     * when the active set has settled without meeting the test.
+     */
+    bool
+    stops(const Statistics             &statistics,
+          const types::global_dof_index n_changes,
+          Stopping                     &stopping) const;
+
+    /** The line of the terminal for one iteration. */
+    void
+    print_iteration(const Statistics             &statistics,
+                    const ActiveSet<dim>         &active_set,
+                    const types::global_dof_index n_changes,
+                    const unsigned int            linear_iterations,
+                    const Stopping               &stopping) const;
 
     /**
      * The squared residual of the equilibrium part of the KKT conditions at
@@ -443,7 +255,7 @@ namespace membranes
     double
     equilibrium_square(const DiscreteAction<dim>   &action,
                        const unsigned int           k,
-                       const IndexSet              &active_set,
+                       const ActiveSet<dim>        &active_set,
                        const std::array<double, 3> &weights) const;
 
     /**
@@ -452,13 +264,13 @@ namespace membranes
      */
     double
     linearization_estimate(const DiscreteAction<dim> &action,
-                           const VectorType          &ghosted_solution,
-                           const IndexSet            &active_set) const;
+                           const VectorType          &solution,
+                           const ActiveSet<dim>      &active_set) const;
 
     /** η_alg of an iterate with λ_a in @p action, over all processes. */
     double
     algebraic_estimate(const DiscreteAction<dim> &action,
-                       const IndexSet            &active_set) const;
+                       const ActiveSet<dim>      &active_set) const;
 
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
@@ -466,15 +278,10 @@ namespace membranes
     TimerOutput              &timer;
     const MPI_Comm            mpi_communicator;
 
-    SmartPointer<const DoFHandler<dim>> dof_handler;
-    IndexSet                            locally_owned_dofs;
-    IndexSet                            locally_relevant_dofs;
+    SmartPointer<const MeshOperator<dim>> mesh;
 
     /** The linear problem of one iteration, coupled or decoupled. */
     std::unique_ptr<ActiveSetSystem<dim>> system;
-
-    /** The active sets visited on the current mesh. */
-    ActiveSetHistory history;
 
     /**
      * c_M C_F of balanced stopping: the Friedrichs constant of the bounding

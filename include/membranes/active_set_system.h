@@ -9,9 +9,9 @@
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/cell_system.h>
-#include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
 #include <membranes/linear_solver.h>
+#include <membranes/mesh_operator.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <optional>
@@ -74,7 +74,8 @@ namespace membranes
    * symmetric positive definite. What does not depend on the active set
    * (the hanging node and boundary constraints, the loads, and for the
    * decoupled system the whole operator) is built once per mesh, in setup()
-   * and prepare(); solve() only does what the active set changes. This
+   * or on the first solve() of a mesh; solve() otherwise only does what the
+   * active set changes. This
    * class holds the matrix and right-hand side of the iteration and the
    * LinearSolver, and the steps both ways share. Every method times its
    * assembly and its linear solves in the sections "assembly" and "solve"
@@ -91,39 +92,24 @@ namespace membranes
 
     /**
      * Matrices, sparsity patterns and the constraints that do not depend on
-     * the active set, for the current mesh of @p dof_handler (the
-     * DoFHandler of (u1, u2)), with room for any active set on the vertices
-     * of @p action.
+     * the active set, for the mesh of @p mesh_operator, with room for any
+     * active set on its vertices.
      */
     virtual void
-    setup(const DoFHandler<dim>     &dof_handler,
-          const IndexSet            &locally_owned_dofs,
-          const IndexSet            &locally_relevant_dofs,
-          const DiscreteAction<dim> &action) = 0;
-
-    /**
-     * Before the first iteration on a mesh, from the initial guess
-     * @p solution: the work that does not depend on the active set, solved
-     * to the residual norms @p tolerances.
-     */
-    virtual void
-    prepare(const VectorType       &solution,
-            const LinearTolerances &tolerances,
-            ActiveSetStatistics    &statistics) = 0;
+    setup(const MeshOperator<dim> &mesh_operator) = 0;
 
     /**
      * Solve the linear problem for @p active_set (u1 DoFs of the active
-     * locally relevant vertices of @p action, so that every process knows
-     * the constraints of the cells it assembles), starting from
-     * @p solution, to the residual norms @p tolerances. On return
-     * @p solution holds (u1h, u2h), constraints included.
+     * locally relevant vertices, ActiveSet::locally_relevant(), so that
+     * every process knows the constraints of the cells it assembles),
+     * starting from @p solution, to the residual norms @p tolerances. On
+     * return @p solution holds (u1h, u2h), constraints included.
      */
     virtual void
-    solve(const DiscreteAction<dim> &action,
-          const IndexSet            &active_set,
-          VectorType                &solution,
-          const LinearTolerances    &tolerances,
-          ActiveSetStatistics       &statistics) = 0;
+    solve(const IndexSet         &active_set,
+          VectorType             &solution,
+          const LinearTolerances &tolerances,
+          ActiveSetStatistics    &statistics) = 0;
 
     /**
      * Free the matrices, vectors and the AMG hierarchy of this mesh once the
@@ -204,6 +190,9 @@ namespace membranes
     const ProblemData<dim>    &data;
     TimerOutput               &timer;
     const MPI_Comm             mpi_communicator;
+
+    /** The mesh, its index sets, constraints, operator and loads. */
+    SmartPointer<const MeshOperator<dim>> mesh;
 
     TrilinosWrappers::SparseMatrix system_matrix;
     VectorType                     system_rhs;

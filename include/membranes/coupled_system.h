@@ -45,26 +45,17 @@ namespace membranes
 
     /**
      * The hanging node and boundary constraints, sparsity pattern and matrix
-     * for the current mesh; the pattern has room for any active set.
+     * for the mesh of @p mesh_operator; the pattern has room for any active
+     * set.
      */
     void
-    setup(const DoFHandler<dim>     &dof_handler,
-          const IndexSet            &locally_owned_dofs,
-          const IndexSet            &locally_relevant_dofs,
-          const DiscreteAction<dim> &action) override;
-
-    /** Nothing: every part of the coupled system depends on the active set. */
-    void
-    prepare(const VectorType       &solution,
-            const LinearTolerances &tolerances,
-            ActiveSetStatistics    &statistics) override;
+    setup(const MeshOperator<dim> &mesh_operator) override;
 
     void
-    solve(const DiscreteAction<dim> &action,
-          const IndexSet            &active_set,
-          VectorType                &solution,
-          const LinearTolerances    &tolerances,
-          ActiveSetStatistics       &statistics) override;
+    solve(const IndexSet         &active_set,
+          VectorType             &solution,
+          const LinearTolerances &tolerances,
+          ActiveSetStatistics    &statistics) override;
 
     /** Also the tensions of the DoFs and the constraints. */
     void
@@ -76,12 +67,8 @@ namespace membranes
      * (locally owned entries; see solve()).
      */
     VectorType
-    tension_scaling(const DiscreteAction<dim> &action,
-                    const IndexSet            &active_set) const;
+    tension_scaling(const IndexSet &active_set) const;
 
-    SmartPointer<const DoFHandler<dim>> dof_handler;
-    IndexSet                            locally_owned_dofs;
-    IndexSet                            locally_relevant_dofs;
     /** Hanging node and boundary constraints of the mesh. */
     AffineConstraints<double> mesh_constraints;
     /** The same with the contact lines of the current active set. */

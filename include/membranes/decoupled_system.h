@@ -47,19 +47,20 @@ namespace membranes
    * problem, on the unconstrained interior vertices.
    *
    * <h3>What one iteration does</h3>
-   * prepare() assembles, once per mesh, the operator A (condensed with the
-   * hanging node constraints and the boundary values, which are the same
-   * lines for S and for W) and the right-hand sides of S and W, and solves
-   * the linear problem for S. solve() then imposes W_a = 0 on the active
+   * The first solve() of a mesh assembles the operator A (condensed with
+   * the hanging node constraints and the boundary values, which are the
+   * same lines for S and for W) and the right-hand sides of S and W, and
+   * solves the linear problem for S from the initial guess. Every solve()
+   * then imposes W_a = 0 on the active
    * set: in the matrix μ̄ A the rows and columns of the active vertices are
    * eliminated (what condensing an AffineConstraints line without entries
    * does), the right-hand side is zeroed there; it solves the obstacle
    * problem's linear system for W (inactive vertices: Λ_a = 0), and writes
    * U1, U2 into the solution of the two-component FESystem. Nothing is
    * assembled and no data are evaluated per iteration. ActiveSetSolver computes
-   * λ_a by (4.5), the next active set and the KKT residual from it exactly as
-   * for the coupled system: the test Λ_a − c_a W_a > 0 with c_a = μ̄
-   * ∫|∇φ_a|²/d_a is the active set test of this obstacle problem, whose
+   * λ_a by (4.5), and ActiveSet the next active set and the KKT residual,
+   * from it exactly as for the coupled system: the test Λ_a − c_a W_a > 0 with
+   * c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of this obstacle problem, whose
    * diagonal is μ̄ A_aa.
    *
    * Both scalar problems live on one scalar DoFHandler (the base element of
@@ -81,32 +82,23 @@ namespace membranes
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * The scalar DoFHandler on the mesh of @p dof_handler, the map between
-     * its DoFs and those of (u1, u2), the constraints of S, and one sparsity
-     * pattern for S and for W with any active set.
+     * The scalar DoFHandler on the mesh of @p mesh_operator, the map between
+     * its DoFs and those of (u1, u2), the constraints of S and of W, and one
+     * sparsity pattern for S and for W with any active set.
      */
     void
-    setup(const DoFHandler<dim>     &dof_handler,
-          const IndexSet            &locally_owned_dofs,
-          const IndexSet            &locally_relevant_dofs,
-          const DiscreteAction<dim> &action) override;
+    setup(const MeshOperator<dim> &mesh_operator) override;
 
     /**
-     * S and W of the initial guess @p solution; then S of this mesh, from
-     * A S = F1 + F2.
+     * W for @p active_set, and (U1, U2) from S and W into @p solution. The
+     * first solve on a mesh first assembles A and the right-hand sides, and
+     * solves for S (solve_sum()).
      */
     void
-    prepare(const VectorType       &solution,
-            const LinearTolerances &tolerances,
-            ActiveSetStatistics    &statistics) override;
-
-    /** W for @p active_set, and (U1, U2) from S and W into @p solution. */
-    void
-    solve(const DiscreteAction<dim> &action,
-          const IndexSet            &active_set,
-          VectorType                &solution,
-          const LinearTolerances    &tolerances,
-          ActiveSetStatistics       &statistics) override;
+    solve(const IndexSet         &active_set,
+          VectorType             &solution,
+          const LinearTolerances &tolerances,
+          ActiveSetStatistics    &statistics) override;
 
     /**
      * Also the scalar DoFHandler, its constraints, A, the matrix of W, S, W,
@@ -124,17 +116,23 @@ namespace membranes
     void
     assemble_operator();
 
+    /**
+     * S and W of the initial guess @p solution, the operator and the
+     * right-hand sides (assemble_operator()), then S of this mesh, from
+     * A S = F1 + F2.
+     */
+    void
+    solve_sum(const VectorType       &solution,
+              const LinearTolerances &tolerances,
+              ActiveSetStatistics    &statistics);
+
     /** μ1 g + μ2 g2 and g − g2: the boundary values of S and of W. */
     const std::unique_ptr<Function<dim>> sum_boundary_values;
     const std::unique_ptr<Function<dim>> difference_boundary_values;
 
-    SmartPointer<const DoFHandler<dim>> dof_handler;
-    /** The loads of the mesh are those of this object. */
-    const DiscreteAction<dim> *action;
-    DoFHandler<dim>            scalar_dof_handler;
-    IndexSet                   locally_owned_scalar_dofs;
-    IndexSet                   locally_relevant_scalar_dofs;
-    IndexSet                   locally_relevant_dofs;
+    DoFHandler<dim> scalar_dof_handler;
+    IndexSet        locally_owned_scalar_dofs;
+    IndexSet        locally_relevant_scalar_dofs;
     /**
      * The DoFs of u1 and u2 at the vertex of each locally owned scalar DoF,
      * by its position in locally_owned_scalar_dofs. (A vertex has the same
@@ -169,6 +167,8 @@ namespace membranes
     /** S = μ1 U1 + μ2 U2 and W = U1 − U2 (locally owned). */
     VectorType sum;
     VectorType difference;
+    /** Whether S has been solved for on this mesh. */
+    bool sum_solved;
   };
 } // namespace membranes
 

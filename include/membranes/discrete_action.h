@@ -5,11 +5,10 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
 #include <membranes/dual_cell_quadrature.h>
+#include <membranes/mesh_operator.h>
 #include <membranes/problem_data.h>
 #include <utility>
 #include <vector>
@@ -45,10 +44,12 @@ namespace membranes
    * The same nodal quantities are the multipliers of the active set solver:
    * λ_a d_a is the residual of membrane 1's equation at a.
    *
-   * Everything is stored for the locally owned vertices of V_h only, in the
-   * order of their u1 DoF index; the DoFs of the locally relevant vertices
-   * (those of the ghost cells too) are known for the constraints and for
-   * λ_h on ghost cells.
+   * V_h, d_a, the operator and the loads are those of the MeshOperator of
+   * the mesh, assembled once per mesh; this class only applies them to a
+   * solution. Everything is stored for the locally owned vertices of V_h
+   * only, in the order of their u1 DoF index; the DoFs of the locally
+   * relevant vertices (those of the ghost cells too) are known for the
+   * constraints and for λ_h on ghost cells.
    */
   template <int dim>
   class DiscreteAction
@@ -57,38 +58,18 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
 
     /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
-    struct Vertex
-    {
-      /** DoF of u1 (index 0) and of u2 (index 1) at a. */
-      std::array<types::global_dof_index, 2> dof;
-      /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
-      double dual_cell_measure;
-      /** ∫ |∇φ_a|², the scale of the stiffness matrix at a. */
-      double stiffness_diagonal;
-      /**
-       * Σ_b |A_ab|, the l1 norm of the row of a in the Laplacian A
-       * condensed with the hanging node constraints (where the hat function
-       * of a takes its share of those of the hanging vertices it
-       * constrains): half of it is the divisor of the projected Jacobi
-       * sweeps of ActiveSetSolver.
-       */
-      double stiffness_row_l1_norm;
-    };
+    using Vertex = typename MeshOperator<dim>::Vertex;
 
     DiscreteAction(const Discretization<dim> &discretization,
                    const ProblemData<dim>    &data);
 
     /**
-     * Find V_h on the current mesh, and assemble what (4.5) needs of it:
-     * d_a, the operator and the loads. @p hanging_node_constraints condense
-     * the hat functions of constrained vertices into their parents.
+     * Work on the mesh of @p mesh_operator, which holds V_h, d_a, the
+     * operator and the loads of (4.5); it must live as long as this object
+     * is used on that mesh.
      */
     void
-    reinit(const DoFHandler<dim>           &dof_handler,
-           const AffineConstraints<double> &hanging_node_constraints,
-           const IndexSet                  &locally_owned_dofs,
-           const IndexSet                  &locally_relevant_dofs,
-           const MPI_Comm                   mpi_communicator);
+    reinit(const MeshOperator<dim> &mesh_operator);
 
     /**
      * Compute λ_a by (4.5) from both membranes for @p solution (locally
@@ -99,19 +80,7 @@ namespace membranes
     void
     compute(const VectorType &solution);
 
-    /**
-     * The loads F_1K, F_2K of the locally owned cell @p cell (CellSystem:
-     * copy_loads(), set_loads()), evaluated once per mesh in reinit().
-     */
-    const double *
-    cell_loads(
-      const typename DoFHandler<dim>::active_cell_iterator &cell) const;
-
-    /**
-     * The mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of load @p i on
-     * the locally owned cell @p cell (CellSystem::load_mean,
-     * CellSystem::load_oscillation), evaluated with the cell loads.
-     */
+    /** MeshOperator::load_mean_and_oscillation() of the mesh. */
     std::pair<double, double>
     load_mean_and_oscillation(
       const typename DoFHandler<dim>::active_cell_iterator &cell,
@@ -122,24 +91,6 @@ namespace membranes
     vertices() const;
 
     /**
-     * The DoFs (u1, u2) of the locally relevant vertices of V_h: those of
-     * the locally owned and ghost cells. A contact constraint of an active
-     * vertex must be known on every process that assembles a cell around
-     * it.
-     */
-    const std::vector<std::array<types::global_dof_index, 2>> &
-    locally_relevant_vertices() const;
-
-    /**
-     * The u1 DoFs of the locally relevant interior vertices: V_h and the
-     * hanging vertices, whose dual cells make up ω_h. On the pieces of a
-     * hanging vertex, λ_h is the constraint-weighted mean of the λ_a of its
-     * parents (AffineConstraints::distribute() of the nodal vector).
-     */
-    const IndexSet &
-    dual_mesh_vertices() const;
-
-    /**
      * Write λ_a into both DoF slots (u1 and u2) of every vertex a of V_h in
      * @p lambda_h, a vector with the layout of the solution; zero
      * elsewhere.
@@ -148,8 +99,8 @@ namespace membranes
     fill_nodal_vector(VectorType &lambda_h) const;
 
     /**
-     * Use @p lambda_h (λ_a in the u1 slot of the vertices of
-     * dual_mesh_vertices(), distributed to the hanging vertices, ghosted)
+     * Use @p lambda_h (λ_a in the u1 slot of the interior vertices,
+     * distributed to the hanging vertices, ghosted)
      * as λ_h; it must live as long as λ_h is read.
      */
     void
@@ -248,38 +199,14 @@ namespace membranes
     /** λ_h as given to set_lambda_h(). */
     const VectorType *lambda_h_vector;
 
-    IndexSet locally_owned_dofs;
-    MPI_Comm mpi_communicator;
+    /** The mesh data of (4.5). */
+    SmartPointer<const MeshOperator<dim>> mesh;
 
-    /**
-     * Assembled once per mesh: the operator U ↦ (μ_i ∫ ∇u_ih·∇φ)_φ, block
-     * diagonal in the membranes, and the loads (∫ f_i φ)_φ, both condensed
-     * with the hanging node constraints (boundary DoFs not eliminated: their
-     * values enter the terms of the interior vertices next to ∂ω).
-     */
-    TrilinosWrappers::SparseMatrix stiffness_matrix;
-    VectorType                     load_vector;
-    /**
-     * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
-     * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
-     * on (n_v hat functions per cell).
-     */
-    std::vector<double> loads_of_cells;
-    unsigned int        loads_per_cell;
-    /** The product of stiffness_matrix with the last solution. */
+    /** The product of the operator of the mesh with the last solution. */
     VectorType stiffness_product;
 
-    std::vector<Vertex> interior_vertices;
-    /**
-     * The positions of the DoFs (u1, u2) of interior_vertices in the local
-     * storage of vectors of the locally owned DoFs (all of them share one
-     * layout), so that compute() reads them without a search per entry.
-     */
-    std::vector<std::array<int, 2>>                     local_positions;
-    std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
-    IndexSet                                            interior_vertex_dofs;
-    double                                              max_force;
-    double                                              max_contact_force;
+    double max_force;
+    double max_contact_force;
   };
 
 

@@ -9,6 +9,7 @@
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/numerics/solution_transfer.h>
+#include <membranes/active_set.h>
 #include <membranes/active_set_solver.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
@@ -16,6 +17,7 @@
 #include <membranes/error_norms.h>
 #include <membranes/field_output.h>
 #include <membranes/flux_reconstruction.h>
+#include <membranes/mesh_operator.h>
 #include <membranes/output_directory.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
@@ -128,8 +130,10 @@ namespace membranes
     VectorType ghosted_solution;
     /** λ_a in both DoF slots of every vertex a of V_h (ghosted). */
     VectorType lambda_h;
-    /** u1 DoFs of the active vertices. */
-    IndexSet active_set;
+    /** Laplacian, loads, d_a and V_h of the current mesh. */
+    MeshOperator<dim> mesh_operator;
+    /** The active vertices. */
+    ActiveSet<dim> active_set;
     /** η_K² of the estimator that drives refinement, by active cell index. */
     Vector<double> indicators;
 
