@@ -316,11 +316,13 @@ namespace membranes::Parameters
                       "for the scene (decoupled, half the size, for constant "
                       "tensions); coupled and decoupled give the same "
                       "discrete solution.");
-    prm.declare_entry("Linear solver",
-                      "auto",
-                      selection(linear_solvers),
-                      "direct: UMFPACK; cg-amg: CG with Trilinos ML AMG; "
-                      "auto: direct for small problems on one process.");
+    prm.declare_entry(
+      "Linear solver",
+      "auto",
+      selection(linear_solvers),
+      "direct: sparse LU (Trilinos Amesos MUMPS), any number of "
+      "processes; cg-amg: CG with Trilinos ML AMG; auto: "
+      "direct for small problems on one process.");
     prm.declare_entry("Tolerance",
                       "1e-10",
                       Double(1e-15, 1e-2),

@@ -117,9 +117,6 @@ MPI_CASES = [
     ("triangles on two processes",
      "subsection Geometry\n  set Cell type = triangle\nend\n", [],
      ["Geometry/Cell type", "one process"]),
-    ("direct solver on two processes",
-     "subsection Solver\n  set Linear solver = direct\nend\n", [],
-     ["Solver/Linear solver", "one process"]),
 ]
 
 

@@ -223,7 +223,7 @@ namespace membranes::Parameters
     /** Coupled (u1, u2), decoupled (s, w), or the faster of the two. */
     SolverMethod method;
     LinearSolverType
-                 linear_solver; ///< UMFPACK, CG with AMG, or chosen by size.
+                 linear_solver; ///< Sparse LU, CG with AMG, or chosen by size.
     double       tolerance;     ///< Relative KKT residual to reach.
     unsigned int max_active_set_iterations; ///< Give up after this many.
     Stopping     stopping; ///< Exact, or balanced against the estimator.
