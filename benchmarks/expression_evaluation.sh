@@ -53,7 +53,7 @@ share() {
     2> /dev/null |
     awk '/^ +[0-9.]+%/ {
            p = $1; sub("%", "", p);
-           if ($0 ~ /libmuparser|expressions-[0-9a-f]+\.so|libm\.so|ProblemData<2>::Expression|ThreadParsers|FunctionParser::mu_/)
+           if ($0 ~ /libmuparser|expressions-[0-9a-f]+\.so|libm\.so|ProblemData<2>::Expression|ExpressionEntry<2>|ThreadParsers|FunctionParser::mu_/)
              s += p
          }
          END { printf "%.1f", s }'
