@@ -1,5 +1,6 @@
 #include <cmath>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/shared_tria.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
@@ -234,17 +235,13 @@ namespace membranes
     if (cell_type == Parameters::CellType::quadrilateral)
       return std::make_unique<parallel::distributed::Triangulation<dim>>(
         mpi_communicator);
-    const unsigned int n_processes =
-      Utilities::MPI::n_mpi_processes(mpi_communicator);
-    if (n_processes > 1)
-      throw Parameters::invalid_entry(
-        "Geometry/Cell type",
-        "triangle",
-        "triangle meshes run on one process only (deal.II 9.4's p4est "
-        "triangulation has no simplices), not on " +
-          std::to_string(n_processes) +
-          ": run with one process, or use 'Cell type = quadrilateral'");
-    return std::make_unique<Triangulation<dim>>();
+    if (getenv("SERIALTEST"))
+      return std::make_unique<Triangulation<dim>>();
+    return std::make_unique<parallel::shared::Triangulation<dim>>(
+      mpi_communicator,
+      Triangulation<dim>::none,
+      /* allow_artificial_cells = */ true,
+      parallel::shared::Triangulation<dim>::partition_zorder);
   }
 
 
@@ -401,6 +398,47 @@ namespace membranes
 
     check_initial_refinement(geometry, triangulation);
     triangulation.refine_global(geometry.initial_refinement);
+    complete_ghost_layer(triangulation);
+  }
+
+
+
+  template <int dim>
+  void
+  complete_ghost_layer(Triangulation<dim> &triangulation)
+  {
+    auto *const shared =
+      dynamic_cast<parallel::shared::Triangulation<dim> *>(&triangulation);
+    if (shared == nullptr || !shared->with_artificial_cells())
+      return;
+    // The vertices a cell touches: its corners and the middle vertices of
+    // its edges that have children.
+    const auto for_each_touched_vertex = [](const auto &cell,
+                                            const auto &visit) {
+      for (const unsigned int v : cell->vertex_indices())
+        visit(cell->vertex_index(v));
+      for (const unsigned int f : cell->face_indices())
+        if (cell->face(f)->has_children())
+          visit(cell->face(f)->child(0)->vertex_index(1));
+    };
+    std::vector<bool> touched_by_owned(triangulation.n_vertices(), false);
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for_each_touched_vertex(cell, [&](const unsigned int vertex) {
+          touched_by_owned[vertex] = true;
+        });
+    const std::vector<types::subdomain_id> &owner =
+      shared->get_true_subdomain_ids_of_cells();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_artificial())
+        {
+          bool touches = false;
+          for_each_touched_vertex(cell, [&](const unsigned int vertex) {
+            touches = touches || touched_by_owned[vertex];
+          });
+          if (touches)
+            cell->set_subdomain_id(owner[cell->active_cell_index()]);
+        }
   }
 
 
@@ -410,4 +448,6 @@ namespace membranes
   make_triangulation<2>(const Parameters::CellType, const MPI_Comm);
   template void
   create_mesh<2>(const Parameters::Geometry &, Triangulation<2> &);
+  template void
+  complete_ghost_layer<2>(Triangulation<2> &);
 } // namespace membranes

@@ -1,10 +1,9 @@
 #include <algorithm>
 #include <deal.II/base/parallel.h>
-#include <deal.II/distributed/tria_base.h>
-#include <deal.II/grid/grid_tools.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <membranes/flux_reconstruction.h>
+#include <membranes/ghost_cell_exchange.h>
 
 // The rotation relaxation of the equilibrated fluxes σ_ih: divergence-free
 // corrections around the vertices of the sub-mesh S_h and inside each cell
@@ -208,7 +207,11 @@ namespace membranes
   void
   FluxReconstruction<dim>::relax_rotations()
   {
-    Rotations rotations = rotations_around_vertices();
+    Rotations              rotations   = rotations_around_vertices();
+    const unsigned int     n_triangles = basis.n_sub_triangles();
+    GhostCellExchange<dim> ghost_cells;
+    ghost_cells.reinit(dof_handler->get_triangulation(),
+                       dof_handler->get_communicator());
 
     // The sweeps work on a copy of the fluxes of σ_ih alone (in the order
     // of sub_triangle_data), which the caches hold far better than
@@ -220,7 +223,7 @@ namespace membranes
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
       for (const unsigned int kind : Rotations::sweep_order)
         {
-          exchange_to_ghosts(sigma);
+          ghost_cells.update_ghosts(sigma, n_triangles);
           for_each_vertex(rotations.vertices_of_kind[kind],
                           [&](const RotationVertex &p) {
                             const auto           &all = rotations.rotations;
@@ -359,31 +362,6 @@ namespace membranes
           }
       });
     return result;
-  }
-
-
-
-  template <int dim>
-  void
-  FluxReconstruction<dim>::exchange_to_ghosts(std::vector<Fluxes> &sigma) const
-  {
-    if (dynamic_cast<const parallel::TriangulationBase<dim> *>(
-          &dof_handler->get_triangulation()) == nullptr)
-      return;
-    const unsigned int n_triangles = basis.n_sub_triangles();
-    GridTools::exchange_cell_data_to_ghosts<std::vector<Fluxes>,
-                                            DoFHandler<dim>>(
-      *dof_handler,
-      [&](const CellIterator &cell) {
-        std::vector<Fluxes> fluxes(n_triangles);
-        for (unsigned int s = 0; s < n_triangles; ++s)
-          fluxes[s] = sigma[cell->active_cell_index() * n_triangles + s];
-        return std::optional<std::vector<Fluxes>>(fluxes);
-      },
-      [&](const CellIterator &cell, const std::vector<Fluxes> &fluxes) {
-        for (unsigned int s = 0; s < n_triangles; ++s)
-          sigma[cell->active_cell_index() * n_triangles + s] = fluxes[s];
-      });
   }
 
 

@@ -181,7 +181,7 @@ namespace membranes
   void
   MembraneProblem<dim>::transfer_solution()
   {
-    if (previous_mesh_vectors.empty())
+    if (!distributed_transfer && !serial_transfer)
       {
         solution = 0;
         active_set.reinit(mesh_operator);
@@ -197,10 +197,21 @@ namespace membranes
         distributed_transfer->interpolate(targets);
       }
     else
-      serial_transfer->interpolate(previous_mesh_vectors, interpolated);
+      {
+        std::vector<Vector<double>> replicated(
+          2, Vector<double>(dof_handler.n_dofs()));
+        serial_transfer->interpolate(replicated_previous_vectors, replicated);
+        for (unsigned int v = 0; v < 2; ++v)
+          {
+            for (const auto i : locally_owned_dofs)
+              interpolated[v][i] = replicated[v][i];
+            interpolated[v].compress(VectorOperation::insert);
+          }
+      }
     distributed_transfer.reset();
     serial_transfer.reset();
     previous_mesh_vectors.clear();
+    replicated_previous_vectors.clear();
 
     for (auto &vector : interpolated)
       hanging_node_constraints.distribute(vector);
@@ -532,6 +543,14 @@ namespace membranes
    * larger one contains the smaller. The solution and λ_h are handed to a
    * SolutionTransfer first, to be interpolated onto the new mesh by
    * transfer_solution().
+   *
+   * A p4est mesh is marked by deal.II's parallel functions, which find the
+   * thresholds by a global bisection. A mesh that every process holds whole
+   * (triangles, on a parallel::shared::Triangulation) is marked by the
+   * serial functions on every process, with the indicators of all cells:
+   * each process contributes those of its own cells (the others are zero)
+   * and the sum is the same vector everywhere, so every process flags the
+   * same cells, the ones that one process would flag.
    */
   template <int dim>
   void
@@ -541,6 +560,14 @@ namespace membranes
     auto *const distributed_triangulation =
       dynamic_cast<parallel::distributed::Triangulation<dim> *>(
         triangulation.get());
+    if (!distributed_triangulation &&
+        refinement.strategy != Parameters::RefinementStrategy::global)
+      {
+        for (const auto &cell : triangulation->active_cell_iterators())
+          if (!cell->is_locally_owned())
+            indicators[cell->active_cell_index()] = 0;
+        Utilities::MPI::sum(indicators, mpi_communicator, indicators);
+      }
     // Flags the cells by a share @p top at the large end of the indicators
     // and @p bottom at the small end, of η² (bulk) or of the cells; on
     // several processes the thresholds are found by a global bisection
@@ -590,10 +617,10 @@ namespace membranes
       }
     triangulation->prepare_coarsening_and_refinement();
 
-    previous_mesh_vectors = {ghosted_solution, lambda_h};
     if (distributed_triangulation)
       {
-        distributed_transfer = std::make_unique<
+        previous_mesh_vectors = {ghosted_solution, lambda_h};
+        distributed_transfer  = std::make_unique<
           parallel::distributed::SolutionTransfer<dim, VectorType>>(
           dof_handler);
         distributed_transfer->prepare_for_coarsening_and_refinement(
@@ -601,12 +628,18 @@ namespace membranes
       }
     else
       {
+        // The whole mesh on every process: the serial SolutionTransfer
+        // interpolates on every cell, so it reads vectors with every entry
+        // (the copy from a distributed vector gathers them).
+        replicated_previous_vectors = {Vector<double>(ghosted_solution),
+                                       Vector<double>(lambda_h)};
         serial_transfer =
-          std::make_unique<SolutionTransfer<dim, VectorType>>(dof_handler);
+          std::make_unique<SolutionTransfer<dim, Vector<double>>>(dof_handler);
         serial_transfer->prepare_for_coarsening_and_refinement(
-          previous_mesh_vectors);
+          replicated_previous_vectors);
       }
     triangulation->execute_coarsening_and_refinement();
+    complete_ghost_layer(*triangulation);
   }
 
 

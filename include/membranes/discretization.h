@@ -72,9 +72,14 @@ namespace membranes
    * - quadrilaterals: a parallel::distributed::Triangulation (p4est), on
    *   any number of processes; one process is the case N = 1 of the same
    *   class, so serial and parallel runs share every line of the program;
-   * - triangles: a serial Triangulation, on one process only (deal.II 9.4's
-   *   p4est triangulation has no simplices); a triangle scene run on more
-   *   processes is an InputError naming `Geometry/Cell type`.
+   * - triangles: a parallel::shared::Triangulation (deal.II 9.4's p4est
+   *   triangulation has no simplices), on any number of processes: every
+   *   process holds the whole mesh, and its active cells are partitioned in
+   *   the z-order that p4est uses, again after every refinement. Each
+   *   process owns its cells and their DoFs and sees one layer of ghost
+   *   cells; the others are artificial to it, as on p4est, so the program
+   *   runs the same lines on both (step-40's owned and relevant index sets,
+   *   ghosted vectors).
    *
    * Mesh smoothing is off for both, so that a refinement step refines what
    * the marking marked (and the hanging-node rule of at most one hanging
@@ -103,6 +108,26 @@ namespace membranes
   void
   create_mesh(const Parameters::Geometry &geometry,
               Triangulation<dim>         &triangulation);
+
+
+
+  /**
+   * Complete the ghost layer of a parallel::shared::Triangulation after
+   * it was partitioned (created or refined): a cell is a ghost cell of a
+   * process if it touches one of the process's own cells, also through a
+   * hanging vertex. deal.II 9.4 makes ghost cells only of the cells that
+   * share a vertex of theirs with an owned cell, so a coarse cell that
+   * meets an owned fine cell only at the hanging vertex in the middle of
+   * its edge would stay artificial, and with it the constraint of that
+   * vertex and the cells around it that the flux reconstruction needs;
+   * p4est's ghost layer has them, and so has this one. Here a cell touches
+   * the vertices of its corners and the hanging vertices in the middle of
+   * its refined edges. On other triangulations, or one process, nothing
+   * changes.
+   */
+  template <int dim>
+  void
+  complete_ghost_layer(Triangulation<dim> &triangulation);
 } // namespace membranes
 
 #endif

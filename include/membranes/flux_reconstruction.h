@@ -537,11 +537,6 @@ namespace membranes
     Rotations
     rotations_around_vertices() const;
 
-    /** σ_ih of the owned cells in @p sigma to the ghost cells. */
-    void
-    exchange_to_ghosts(
-      std::vector<std::array<std::array<double, 3>, 2>> &sigma) const;
-
     /** Sweeps of relax_rotations(). */
     static constexpr unsigned int rotation_sweeps = 3;
 

@@ -149,12 +149,15 @@ namespace membranes
 
     /**
      * Carries (u_h, λ_h) from one mesh to the next: the distributed
-     * SolutionTransfer on p4est meshes, the serial one on triangles.
+     * SolutionTransfer on p4est meshes, with the ghosted vectors; the serial
+     * one on triangles, whose mesh every process holds whole, with copies
+     * of the vectors that hold every entry.
      */
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>>
-                                                       distributed_transfer;
-    std::unique_ptr<SolutionTransfer<dim, VectorType>> serial_transfer;
-    std::vector<VectorType>                            previous_mesh_vectors;
+                            distributed_transfer;
+    std::vector<VectorType> previous_mesh_vectors;
+    std::unique_ptr<SolutionTransfer<dim, Vector<double>>> serial_transfer;
+    std::vector<Vector<double>> replicated_previous_vectors;
 
     /** The row of the current cycle. */
     CycleRecord record;
