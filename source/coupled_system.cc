@@ -10,7 +10,7 @@ namespace membranes
     /**
      * @p matrix ← D @p matrix D in place, for the diagonal D of @p scaling
      * (ghosted: it holds the entries of every column of the locally owned
-     * rows).
+     * rows, see column_scaling()).
      */
     void
     scale_symmetrically(const TrilinosWrappers::SparseMatrix &matrix,
@@ -32,6 +32,28 @@ namespace membranes
           for (int k = 0; k < n_entries; ++k)
             values[k] *= row_scaling * column_scaling[columns[k]];
         }
+    }
+
+
+
+    /**
+     * @p scaling with the entries of every column of the locally owned rows
+     * of @p matrix. These are more than the locally relevant DoFs: a cell
+     * of another process adds to an owned row the columns of the parents
+     * of its hanging vertices, which need not lie on a cell of this
+     * process.
+     */
+    TrilinosWrappers::MPI::Vector
+    column_scaling(const TrilinosWrappers::SparseMatrix &matrix,
+                   const TrilinosWrappers::MPI::Vector  &scaling)
+    {
+      IndexSet columns(matrix.trilinos_matrix().ColMap());
+      columns.add_indices(scaling.locally_owned_elements());
+      TrilinosWrappers::MPI::Vector ghosted(scaling.locally_owned_elements(),
+                                            columns,
+                                            scaling.get_mpi_communicator());
+      ghosted = scaling;
+      return ghosted;
     }
   } // namespace
 
@@ -161,11 +183,8 @@ namespace membranes
       // only r_S), so one bound on it bounds r_S and r_W each on its own
       // scale.
       scaling = tension_scaling(active_set);
-      VectorType ghosted_scaling(mesh.locally_owned_dofs(),
-                                 mesh.locally_relevant_dofs(),
-                                 this->mpi_communicator);
-      ghosted_scaling = scaling;
-      scale_symmetrically(this->system_matrix, ghosted_scaling);
+      scale_symmetrically(this->system_matrix,
+                          column_scaling(this->system_matrix, scaling));
       this->system_rhs.scale(scaling);
     }
 

@@ -43,8 +43,7 @@ namespace
     "  -s, --set 'Sub/Entry=val'  override one entry after reading the scene,\n"
     "                             e.g. --set 'Refinement/Cycles=4'\n"
     "\n"
-    "Run on N processes with 'mpirun -np N membranes scene.prm'\n"
-    "(quadrilateral meshes; triangle meshes run on one process).\n"
+    "Run on N processes with 'mpirun -np N membranes scene.prm'.\n"
     "\n"
     "Exit status: 0 on success, 1 with a one-line message on any error.\n";
 

@@ -44,13 +44,24 @@ namespace membranes
 
 
 
-  /** The coarse mesh, and the check of the boundary data against it. */
+  /**
+   * The coarse mesh, and the check of the boundary data against it. Every
+   * process builds the coarse mesh from the same scene (and the same mesh
+   * file), so an error there is met by all of them alike.
+   */
   template <int dim>
   void
   MembraneProblem<dim>::make_grid()
   {
     check_output_directory();
-    create_mesh(parameters.geometry, *triangulation);
+    try
+      {
+        create_mesh(parameters.geometry, *triangulation);
+      }
+    catch (const Parameters::InputError &error)
+      {
+        throw Parameters::CollectiveError(error.what());
+      }
     discretization.select_mapping(*triangulation);
     data.check_boundary_data(*triangulation);
     data.check_exact_solution(*triangulation,
