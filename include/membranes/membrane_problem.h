@@ -44,7 +44,8 @@ namespace membranes
    * to the report, write fields.
    *
    * Data layout is that of deal.II's step-40: a distributed triangulation
-   * (make_triangulation(): p4est for quadrilaterals, serial for triangles),
+   * (make_triangulation(): p4est for quadrilaterals, a shared triangulation
+   * for triangles),
    * locally owned and locally relevant index sets, Trilinos vectors and
    * matrices, ghosted vectors for reading; every cell loop runs over the
    * locally owned cells (and the ghost cells where a quantity of an owned
