@@ -110,6 +110,19 @@ namespace membranes
 
 
   template <int dim>
+  void
+  CellSystem<dim>::set_loads(const double *cell_loads)
+  {
+    for (auto &load : loads)
+      for (unsigned int v = 0; v < load.size(); ++v)
+        load(v) = *cell_loads++;
+    for (unsigned int j = 0; j < dof_indices.size(); ++j)
+      rhs(j) = loads[membrane[j]](scalar_index[j]);
+  }
+
+
+
+  template <int dim>
   unsigned int
   CellSystem<dim>::n_load_entries() const
   {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <membranes/coupled_system.h>
 #include <membranes/matrix_rows.h>
@@ -44,17 +45,14 @@ namespace membranes
                                locally_relevant_dofs);
 
     // Where the entries of each column of the mesh's operator go in the
-    // system matrix, and whether it is a column of a boundary DoF.
+    // system matrix.
     const MatrixRows operator_rows(mesh_operator.stiffness_matrix());
     const MatrixRows rows(this->system_matrix);
     column_of_operator_column.resize(operator_rows.n_columns());
-    constrained_column.resize(operator_rows.n_columns());
     for (unsigned int c = 0; c < operator_rows.n_columns(); ++c)
-      {
-        const auto dof               = operator_rows.global_column(c);
-        column_of_operator_column[c] = rows.local_column(dof);
-        constrained_column[c]        = mesh_constraints.is_constrained(dof);
-      }
+      column_of_operator_column[c] =
+        rows.local_column(operator_rows.global_column(c));
+    make_mesh_rhs();
 
     // The tension μ_i of the membrane of each locally owned DoF.
     tension.reinit(locally_owned_dofs, this->mpi_communicator);
@@ -71,6 +69,42 @@ namespace membranes
                   .mu[dof_handler.get_fe().system_to_component_index(i).first];
         }
     tension.compress(VectorOperation::insert);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::make_mesh_rhs()
+  {
+    // The loads of each cell, condensed with mesh_constraints; the cell
+    // matrix lifts the boundary values on the cells that have DoFs with
+    // one, and is not needed elsewhere.
+    const MeshOperator<dim> &mesh = *this->mesh;
+    CellSystem<dim>          cell_system(this->discretization, this->data);
+    const FullMatrix<double> no_matrix(cell_system.matrix.m());
+    const auto               lifts = [&](const types::global_dof_index j) {
+      return mesh_constraints.is_inhomogeneously_constrained(j);
+    };
+    mesh_rhs.reinit(mesh.locally_owned_dofs(), this->mpi_communicator);
+    for (const auto &cell : mesh.get_dof_handler().active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(cell_system.dof_indices);
+          const bool lifting = std::any_of(cell_system.dof_indices.begin(),
+                                           cell_system.dof_indices.end(),
+                                           lifts);
+          if (lifting)
+            cell_system.reinit_operator(cell);
+          cell_system.set_loads(mesh.cell_loads(cell));
+          mesh_constraints.distribute_local_to_global(cell_system.rhs,
+                                                      cell_system.dof_indices,
+                                                      mesh_rhs,
+                                                      lifting ?
+                                                        cell_system.matrix :
+                                                        no_matrix);
+        }
+    mesh_rhs.compress(VectorOperation::add);
   }
 
 
@@ -152,25 +186,18 @@ namespace membranes
             position[row.columns[e]] = e;
             row.values[e]            = 0;
           }
-        // Row j of the mesh's operator, its boundary columns lifted to the
-        // right-hand side.
+        // Row j of the mesh's operator and of its right-hand side; the
+        // columns of constrained DoFs, not in the system's pattern, are
+        // lifted in mesh_rhs.
         double     rhs     = 0;
         const auto add_row = [&](const types::global_dof_index j) {
           const auto operator_row = operator_rows[operator_rows.local_row(j)];
-          rhs += loads[j];
+          rhs += mesh_rhs[j];
           for (unsigned int e = 0; e < operator_row.values.size(); ++e)
             {
-              const int c = operator_row.columns[e];
-              if (constrained_column[c])
-                rhs -=
-                  operator_row.values[e] * mesh_constraints.get_inhomogeneity(
-                                             operator_rows.global_column(c));
-              else
-                {
-                  Assert(column[c] >= 0 && position[column[c]] >= 0,
-                         ExcInternalError());
-                  row.values[position[column[c]]] += operator_row.values[e];
-                }
+              const int c = column[operator_row.columns[e]];
+              if (c >= 0 && position[c] >= 0)
+                row.values[position[c]] += operator_row.values[e];
             }
         };
         add_row(i);
@@ -243,8 +270,8 @@ namespace membranes
     ActiveSetSystem<dim>::clear();
     tension.clear();
     constraints.clear();
+    mesh_rhs.clear();
     column_of_operator_column = {};
-    constrained_column        = {};
   }
 
 

@@ -64,8 +64,6 @@ namespace membranes
   {
     this->mesh                         = &mesh_operator;
     const DoFHandler<dim> &dof_handler = mesh_operator.get_dof_handler();
-    const IndexSet        &locally_relevant_dofs =
-      mesh_operator.locally_relevant_dofs();
     scalar_dof_handler.reinit(dof_handler.get_triangulation());
     scalar_dof_handler.distribute_dofs(
       this->discretization.fe->base_element(0));
@@ -73,31 +71,24 @@ namespace membranes
     DoFTools::extract_locally_relevant_dofs(scalar_dof_handler,
                                             locally_relevant_scalar_dofs);
 
-    // Shape function v of the scalar element and shape function
-    // component_to_system_index(i, v) of the FESystem belong to the same
-    // vertex of a cell.
+    // Both DoFHandlers number the vertices in the same order, the FESystem
+    // the DoFs of u1 and u2 at a vertex one after the other: the DoFs of
+    // scalar DoF k are 2k and 2k + 1 (membrane_dof()). Checked here on the
+    // cells of this process.
     const FiniteElement<dim>            &fe = *this->discretization.fe;
     std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
     std::vector<types::global_dof_index> scalar_dof_indices(
       fe.base_element(0).n_dofs_per_cell());
-    membrane_dofs.resize(locally_owned_scalar_dofs.n_elements());
-    scalar_dof.resize(locally_relevant_dofs.n_elements());
     for (const auto &scalar_cell : scalar_dof_handler.active_cell_iterators())
-      if (!scalar_cell->is_artificial())
+      if (scalar_cell->is_locally_owned())
         {
           scalar_cell->get_dof_indices(scalar_dof_indices);
           cell_of(dof_handler, scalar_cell)->get_dof_indices(dof_indices);
           for (unsigned int v = 0; v < scalar_dof_indices.size(); ++v)
             for (unsigned int i = 0; i < 2; ++i)
-              {
-                const auto k = scalar_dof_indices[v];
-                const auto dof =
-                  dof_indices[fe.component_to_system_index(i, v)];
-                if (locally_owned_scalar_dofs.is_element(k))
-                  membrane_dofs[locally_owned_scalar_dofs.index_within_set(k)]
-                               [i] = dof;
-                scalar_dof[locally_relevant_dofs.index_within_set(dof)] = k;
-              }
+              AssertThrow(dof_indices[fe.component_to_system_index(i, v)] ==
+                            membrane_dof(scalar_dof_indices[v], i),
+                          ExcInternalError());
         }
 
     // Both scalar problems have the hanging node constraints and boundary
@@ -134,11 +125,10 @@ namespace membranes
     this->system_matrix.clear();
     const MatrixRows operator_rows(mesh_operator.stiffness_matrix());
     const MatrixRows rows(preconditioner_matrix);
-    const std::vector<types::global_dof_index> columns =
-      scalar_columns(operator_rows);
-    column_of_operator_column.resize(columns.size());
-    for (unsigned int c = 0; c < columns.size(); ++c)
-      column_of_operator_column[c] = rows.local_column(columns[c]);
+    column_of_operator_column.resize(operator_rows.n_columns());
+    for (unsigned int c = 0; c < operator_rows.n_columns(); ++c)
+      column_of_operator_column[c] =
+        rows.local_column(operator_rows.global_column(c) / 2);
     difference_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     sum.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     difference.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
@@ -148,15 +138,11 @@ namespace membranes
 
 
   template <int dim>
-  std::vector<types::global_dof_index>
-  DecoupledSystem<dim>::scalar_columns(const MatrixRows &operator_rows) const
+  types::global_dof_index
+  DecoupledSystem<dim>::membrane_dof(const types::global_dof_index k,
+                                     const unsigned int            i)
   {
-    const IndexSet &locally_relevant_dofs = this->mesh->locally_relevant_dofs();
-    std::vector<types::global_dof_index> columns(operator_rows.n_columns());
-    for (unsigned int c = 0; c < columns.size(); ++c)
-      columns[c] = scalar_dof[locally_relevant_dofs.index_within_set(
-        operator_rows.global_column(c))];
-    return columns;
+    return 2 * k + i;
   }
 
 
@@ -181,8 +167,6 @@ namespace membranes
     FullMatrix<double> laplace_matrix(n_vertices),
       difference_matrix(n_vertices);
     Vector<double> sum_loads(n_vertices), difference_loads(n_vertices);
-    std::array<Vector<double>, 2> cell_loads{
-      {Vector<double>(n_vertices), Vector<double>(n_vertices)}};
     std::vector<types::global_dof_index> scalar_dof_indices(n_vertices);
     const auto is_constrained = [&](const types::global_dof_index k) {
       return constrained_scalar_dofs.is_element(k);
@@ -200,16 +184,12 @@ namespace membranes
         {
           cell_of(scalar_dof_handler, cell)
             ->get_dof_indices(scalar_dof_indices);
-          const double *loads = this->mesh->cell_loads(cell);
-          for (unsigned int i = 0; i < 2; ++i)
-            std::copy(loads + i * n_vertices,
-                      loads + (i + 1) * n_vertices,
-                      cell_loads[i].begin());
-          sum_loads = cell_loads[0];
-          sum_loads.add(1., cell_loads[1]);
-          difference_loads = cell_loads[0];
+          cell_system.set_loads(this->mesh->cell_loads(cell));
+          sum_loads = cell_system.loads[0];
+          sum_loads.add(1., cell_system.loads[1]);
+          difference_loads = cell_system.loads[0];
           difference_loads *= mu2 / M;
-          difference_loads.add(-mu1 / M, cell_loads[1]);
+          difference_loads.add(-mu1 / M, cell_system.loads[1]);
           if (std::none_of(scalar_dof_indices.begin(),
                            scalar_dof_indices.end(),
                            is_constrained))
@@ -268,14 +248,13 @@ namespace membranes
     for (unsigned int c = 0; c < rows.n_columns(); ++c)
       active_column[c] = active_scalar_dofs.is_element(rows.global_column(c));
     std::vector<int> position(rows.n_columns(), -1);
-    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+    for (const auto k : locally_owned_scalar_dofs)
       {
-        const auto k   = locally_owned_scalar_dofs.nth_index_in_set(j);
         const auto row = rows[rows.local_row(k)];
         if (constrained_scalar_dofs.is_element(k))
           {
             AssertDimension(row.values.size(), 1);
-            row.values[0] = coefficient * laplace_diagonal[membrane_dofs[j][0]];
+            row.values[0] = coefficient * laplace_diagonal[membrane_dof(k, 0)];
             continue;
           }
         for (unsigned int e = 0; e < row.values.size(); ++e)
@@ -285,7 +264,7 @@ namespace membranes
           }
         const bool active_row = active_scalar_dofs.is_element(k);
         const auto operator_row =
-          operator_rows[operator_rows.local_row(membrane_dofs[j][0])];
+          operator_rows[operator_rows.local_row(membrane_dof(k, 0))];
         for (unsigned int e = 0; e < operator_row.values.size(); ++e)
           {
             const int c = column_of_operator_column[operator_row.columns[e]];
@@ -313,11 +292,10 @@ namespace membranes
     {
       TimerOutput::Scope scope(this->timer, "assembly");
       const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-      for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+      for (const auto k : locally_owned_scalar_dofs)
         {
-          const auto   k  = locally_owned_scalar_dofs.nth_index_in_set(j);
-          const double u1 = solution[membrane_dofs[j][0]];
-          const double u2 = solution[membrane_dofs[j][1]];
+          const double u1 = solution[membrane_dof(k, 0)];
+          const double u2 = solution[membrane_dof(k, 1)];
           sum[k]          = mu1 * u1 + mu2 * u2;
           difference[k]   = u1 - u2;
         }
@@ -351,16 +329,14 @@ namespace membranes
   {
     if (!sum_solved)
       solve_sum(solution, tolerances, statistics);
-    const IndexSet &locally_relevant_dofs = this->mesh->locally_relevant_dofs();
-    const double    mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double    M = mu1 + mu2;
+    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double       M = mu1 + mu2;
     TimerOutput::Scope assembly(this->timer, "assembly");
 
     // The scalar DoFs of the active vertices; W = 0 there.
     IndexSet active_scalar_dofs(scalar_dof_handler.n_dofs());
     for (const auto dof : active_set)
-      active_scalar_dofs.add_index(
-        scalar_dof[locally_relevant_dofs.index_within_set(dof)]);
+      active_scalar_dofs.add_index(dof / 2);
     active_scalar_dofs.compress();
     const IndexSet owned_active_scalar_dofs =
       active_scalar_dofs & locally_owned_scalar_dofs;
@@ -401,11 +377,10 @@ namespace membranes
     TimerOutput::Scope scope(this->timer, "solve");
     set_active_to_zero(difference);
     difference_constraints.distribute(difference);
-    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+    for (const auto k : locally_owned_scalar_dofs)
       {
-        const auto k = locally_owned_scalar_dofs.nth_index_in_set(j);
-        solution[membrane_dofs[j][0]] = (sum[k] + mu2 * difference[k]) / M;
-        solution[membrane_dofs[j][1]] = (sum[k] - mu1 * difference[k]) / M;
+        solution[membrane_dof(k, 0)] = (sum[k] + mu2 * difference[k]) / M;
+        solution[membrane_dof(k, 1)] = (sum[k] - mu1 * difference[k]) / M;
       }
     solution.compress(VectorOperation::insert);
   }
@@ -422,8 +397,6 @@ namespace membranes
       vector->clear();
     sum_constraints.clear();
     difference_constraints.clear();
-    membrane_dofs             = {};
-    scalar_dof                = {};
     column_of_operator_column = {};
     constrained_scalar_dofs.clear();
     scalar_dof_handler.clear();

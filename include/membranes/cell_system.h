@@ -32,9 +32,10 @@ namespace membranes
    *
    * MeshOperator assembles the operator and the loads of the mesh from the
    * FESystem parts, once per mesh, and keeps the loads F_iK of each cell;
-   * the systems of the active set method and the discrete action (4.5)
-   * take them from there: all see the same bilinear form and the same
-   * quadrature of the loads.
+   * the systems of the active set method condense the loads of each cell
+   * (the coupled one from the FESystem parts, the decoupled one from F_iK)
+   * and take their matrices from the mesh's operator: all see the same
+   * bilinear form and the same quadrature of the loads.
    */
   template <int dim>
   class CellSystem
@@ -55,6 +56,13 @@ namespace membranes
      */
     void
     reinit_operator(const typename DoFHandler<dim>::active_cell_iterator &cell);
+
+    /**
+     * Set `loads` and `rhs` from @p cell_loads: F_1K, then F_2K, as
+     * copy_loads() writes them.
+     */
+    void
+    set_loads(const double *cell_loads);
 
     /** The number of entries that copy_loads() writes: 2 n_v + 4. */
     unsigned int

@@ -72,16 +72,19 @@ namespace membranes
     VectorType
     tension_scaling(const IndexSet &active_set) const;
 
+    /** mesh_rhs, from the loads of the mesh's cells. */
+    void
+    make_mesh_rhs();
+
     /**
      * The system matrix and right-hand side of @p active_set, condensed
      * with the constraints of the mesh and the contact lines and scaled
      * symmetrically by @p scaling: in each locally owned unconstrained row
      * i the rows of the mesh's operator of i and, if i is the u2 DoF of an
      * active vertex, of its u1 DoF, the columns of u1 DoFs of active
-     * vertices moved to their u2 DoFs, those of boundary DoFs lifted to the
-     * right-hand side with the boundary values; a constrained row (boundary,
-     * hanging, or u1 of an active vertex) keeps only the diagonal
-     * Σ_K μ_i A_K(i, i), and zero on the right.
+     * vertices moved to their u2 DoFs, and the same rows of mesh_rhs; a
+     * constrained row (boundary, hanging, or u1 of an active vertex) keeps
+     * only the diagonal Σ_K μ_i A_K(i, i), and zero on the right.
      */
     void
     make_system(const IndexSet &active_set, const VectorType &scaling);
@@ -93,12 +96,15 @@ namespace membranes
     /** μ_i at each locally owned DoF of membrane i. */
     VectorType tension;
     /**
-     * For each local column of the mesh's operator, the local column of the
-     * system matrix (−1 if none) and whether its DoF is constrained by
-     * mesh_constraints.
+     * The loads condensed with mesh_constraints (boundary values lifted),
+     * zero in constrained rows: made once per mesh.
      */
-    std::vector<int>  column_of_operator_column;
-    std::vector<bool> constrained_column;
+    VectorType mesh_rhs;
+    /**
+     * For each local column of the mesh's operator, the local column of the
+     * system matrix (−1 if none).
+     */
+    std::vector<int> column_of_operator_column;
   };
 } // namespace membranes
 

@@ -84,9 +84,9 @@ namespace membranes
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * The scalar DoFHandler on the mesh of @p mesh_operator, the map between
-     * its DoFs and those of (u1, u2), the constraints of S and of W, and one
-     * sparsity pattern for S and for W with any active set.
+     * The scalar DoFHandler on the mesh of @p mesh_operator, the constraints
+     * of S and of W, and one sparsity pattern for S and for W with any
+     * active set.
      */
     void
     setup(const MeshOperator<dim> &mesh_operator) override;
@@ -103,19 +103,19 @@ namespace membranes
           ActiveSetStatistics    &statistics) override;
 
     /**
-     * Also the scalar DoFHandler, its constraints, the matrices of W, S, W,
-     * the right-hand side of W and the maps between the DoFs.
+     * Also the scalar DoFHandler, its constraints, the matrices of W, S, W
+     * and the right-hand side of W.
      */
     void
     clear() override;
 
   private:
     /**
-     * The scalar DoFs of the columns of the mesh's operator @p operator_rows
-     * (by local column; all locally relevant).
+     * The DoF of u_i (i = 0, 1) at the vertex of scalar DoF @p k; the
+     * scalar DoF of a DoF j of (u1, u2) is j / 2.
      */
-    std::vector<types::global_dof_index>
-    scalar_columns(const MatrixRows &operator_rows) const;
+    static types::global_dof_index
+    membrane_dof(const types::global_dof_index k, const unsigned int i);
 
     /**
      * The right-hand sides of S (into system_rhs) and of W (without the
@@ -154,17 +154,6 @@ namespace membranes
     DoFHandler<dim> scalar_dof_handler;
     IndexSet        locally_owned_scalar_dofs;
     IndexSet        locally_relevant_scalar_dofs;
-    /**
-     * The DoFs of u1 and u2 at the vertex of each locally owned scalar DoF,
-     * by its position in locally_owned_scalar_dofs. (A vertex has the same
-     * owner in both DoFHandlers: the same rule on the same mesh.)
-     */
-    std::vector<std::array<types::global_dof_index, 2>> membrane_dofs;
-    /**
-     * The scalar DoF of each locally relevant DoF of (u1, u2), by its
-     * position in locally_relevant_dofs.
-     */
-    std::vector<types::global_dof_index> scalar_dof;
 
     /** Hanging node constraints and the boundary values of S, of W. */
     AffineConstraints<double> sum_constraints;
