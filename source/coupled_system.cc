@@ -134,7 +134,6 @@ namespace membranes
                                   const VectorType &scaling)
   {
     const MeshOperator<dim> &mesh             = *this->mesh;
-    const auto              &loads            = mesh.load_vector();
     const auto              &laplace_diagonal = mesh.laplace_diagonal();
     const MatrixRows         operator_rows(mesh.stiffness_matrix());
     const MatrixRows         rows(this->system_matrix);

@@ -48,12 +48,13 @@ namespace membranes
    * problem, on the unconstrained interior vertices.
    *
    * <h3>What one iteration does</h3>
-   * Nothing is assembled: A is the block μ1 A of the operator of the mesh
-   * (MeshOperator) divided by μ1, its loads are those of the mesh. The
-   * first solve() of a mesh makes the right-hand sides of S and W (the
-   * loads, the boundary values lifted by A and μ̄ A; the hanging node
-   * constraints and the boundary values are the same lines for S and for
-   * W) and solves the linear problem for S from the initial guess. Every
+   * The Laplacian is not assembled again: A is the block μ1 A of the
+   * operator of the mesh (MeshOperator) divided by μ1. The first solve() of
+   * a mesh condenses the cell loads of the mesh into the right-hand sides
+   * of S and W (the boundary values lifted by A_K and μ̄ A_K on the cells
+   * at ∂ω; the hanging node constraints and the boundary values are the
+   * same lines for S and for W) and solves the linear problem for S from
+   * the initial guess. Every
    * solve() then imposes W_a = 0 on the active set: it writes μ̄ A into the
    * matrix of W with the rows and columns of the active vertices
    * eliminated (what condensing an AffineConstraints line without entries
