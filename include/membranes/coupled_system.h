@@ -20,11 +20,12 @@ namespace membranes
    * Condensing the constraint adds the equations of u1 and u2 at a, so the
    * solution of each iteration satisfies Prop. 12 (λ from either membrane)
    * by construction; on inactive vertices both equations hold, i.e.
-   * λ_a = 0. Nothing is assembled: the condensed system of an iteration
-   * is made from the operator and the loads of the mesh (MeshOperator) in
-   * one pass over their entries, the hanging node constraints and boundary
-   * values (built once per mesh) and the contact lines of the active set
-   * condensed as AffineConstraints would condense them in the assembly.
+   * λ_a = 0. The Laplacian is not assembled again: the condensed system of
+   * an iteration is made in one pass over the entries of the operator of
+   * the mesh (MeshOperator) and of its loads, condensed once per mesh with
+   * the hanging node constraints and boundary values; per iteration only
+   * the contact lines of the active set are condensed, as AffineConstraints
+   * would condense them in an assembly.
    *
    * The rows of the two membranes are forces of tensions μ1 and μ2, and of
    * μ1 + μ2 where the contact constraint adds them: for tension ratios far
