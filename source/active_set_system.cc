@@ -49,14 +49,13 @@ namespace membranes
   template <int dim>
   void
   ActiveSetSystem<dim>::make_mesh_constraints(
-    const DoFHandler<dim>     &dof_handler,
-    const Function<dim>       &boundary_values,
-    const IndexSet            &locally_relevant_dofs,
-    AffineConstraints<double> &constraints) const
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const Function<dim>             &boundary_values,
+    AffineConstraints<double>       &constraints) const
   {
     constraints.clear();
-    constraints.reinit(locally_relevant_dofs);
-    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
+    constraints.reinit(hanging_node_constraints.get_local_lines());
     std::map<types::boundary_id, const Function<dim> *> boundary_functions;
     for (const auto id : dof_handler.get_triangulation().get_boundary_ids())
       boundary_functions[id] = &boundary_values;
@@ -64,6 +63,10 @@ namespace membranes
                                              dof_handler,
                                              boundary_functions,
                                              constraints);
+    // A hanging vertex on ∂ω keeps its hanging node constraint, its value
+    // that of the boundary values of its parents.
+    constraints.merge(hanging_node_constraints,
+                      AffineConstraints<double>::right_object_wins);
     constraints.close();
   }
 

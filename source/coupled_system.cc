@@ -1,58 +1,29 @@
-#include <Epetra_CrsMatrix.h>
+#include <algorithm>
 #include <cmath>
-#include <deal.II/dofs/dof_tools.h>
 #include <membranes/coupled_system.h>
+#include <membranes/matrix_rows.h>
 
 namespace membranes
 {
   namespace
   {
     /**
-     * @p matrix ← D @p matrix D in place, for the diagonal D of @p scaling
-     * (ghosted: it holds the entries of every column of the locally owned
-     * rows, see column_scaling()).
-     */
-    void
-    scale_symmetrically(const TrilinosWrappers::SparseMatrix &matrix,
-                        const TrilinosWrappers::MPI::Vector  &scaling)
-    {
-      // Epetra's row views point into the matrix's storage, writable even
-      // through a const matrix (as in DecoupledSystem).
-      const Epetra_CrsMatrix &epetra = matrix.trilinos_matrix();
-      std::vector<double>     column_scaling(epetra.NumMyCols());
-      for (int c = 0; c < epetra.NumMyCols(); ++c)
-        column_scaling[c] = scaling[epetra.GCID64(c)];
-      for (int row = 0; row < epetra.NumMyRows(); ++row)
-        {
-          int     n_entries;
-          double *values;
-          int    *columns;
-          epetra.ExtractMyRowView(row, n_entries, values, columns);
-          const double row_scaling = scaling[epetra.GRID64(row)];
-          for (int k = 0; k < n_entries; ++k)
-            values[k] *= row_scaling * column_scaling[columns[k]];
-        }
-    }
-
-
-
-    /**
-     * @p scaling with the entries of every column of the locally owned rows
-     * of @p matrix. These are more than the locally relevant DoFs: a cell
-     * of another process adds to an owned row the columns of the parents
-     * of its hanging vertices, which need not lie on a cell of this
-     * process.
+     * @p owned with the entries of every column of the locally owned rows
+     * of @p matrix as well. These are more than the locally relevant DoFs:
+     * a cell of another process adds to an owned row the columns of the
+     * parents of its hanging vertices, which need not lie on a cell of
+     * this process.
      */
     TrilinosWrappers::MPI::Vector
-    column_scaling(const TrilinosWrappers::SparseMatrix &matrix,
-                   const TrilinosWrappers::MPI::Vector  &scaling)
+    on_columns_of(const TrilinosWrappers::SparseMatrix &matrix,
+                  const TrilinosWrappers::MPI::Vector  &owned)
     {
       IndexSet columns(matrix.trilinos_matrix().ColMap());
-      columns.add_indices(scaling.locally_owned_elements());
-      TrilinosWrappers::MPI::Vector ghosted(scaling.locally_owned_elements(),
+      columns.add_indices(owned.locally_owned_elements());
+      TrilinosWrappers::MPI::Vector ghosted(owned.locally_owned_elements(),
                                             columns,
-                                            scaling.get_mpi_communicator());
-      ghosted = scaling;
+                                            owned.get_mpi_communicator());
+      ghosted = owned;
       return ghosted;
     }
   } // namespace
@@ -90,13 +61,23 @@ namespace membranes
     // cell (condensed with the hanging node constraints) holds the matrix
     // of every active set. Boundary rows are constrained for good.
     this->make_mesh_constraints(dof_handler,
+                                mesh_operator.hanging_node_constraints(),
                                 this->data.boundary_values(),
-                                locally_relevant_dofs,
                                 mesh_constraints);
     this->reinit_linear_system(dof_handler,
                                mesh_constraints,
                                locally_owned_dofs,
                                locally_relevant_dofs);
+
+    // Where the entries of each column of the mesh's operator go in the
+    // system matrix.
+    const MatrixRows operator_rows(mesh_operator.stiffness_matrix());
+    const MatrixRows rows(this->system_matrix);
+    column_of_operator_column.resize(operator_rows.n_columns());
+    for (unsigned int c = 0; c < operator_rows.n_columns(); ++c)
+      column_of_operator_column[c] =
+        rows.local_column(operator_rows.global_column(c));
+    make_mesh_rhs();
 
     // The tension μ_i of the membrane of each locally owned DoF.
     tension.reinit(locally_owned_dofs, this->mpi_communicator);
@@ -118,6 +99,42 @@ namespace membranes
 
 
   template <int dim>
+  void
+  CoupledSystem<dim>::make_mesh_rhs()
+  {
+    // The loads of each cell, condensed with mesh_constraints; the cell
+    // matrix lifts the boundary values on the cells that have DoFs with
+    // one, and is not needed elsewhere.
+    const MeshOperator<dim> &mesh = *this->mesh;
+    CellSystem<dim>          cell_system(this->discretization, this->data);
+    const FullMatrix<double> no_matrix(cell_system.matrix.m());
+    const auto               lifts = [&](const types::global_dof_index j) {
+      return mesh_constraints.is_inhomogeneously_constrained(j);
+    };
+    mesh_rhs.reinit(mesh.locally_owned_dofs(), this->mpi_communicator);
+    for (const auto &cell : mesh.get_dof_handler().active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(cell_system.dof_indices);
+          const bool lifting = std::any_of(cell_system.dof_indices.begin(),
+                                           cell_system.dof_indices.end(),
+                                           lifts);
+          if (lifting)
+            cell_system.reinit_operator(cell);
+          cell_system.set_loads(mesh.cell_loads(cell));
+          mesh_constraints.distribute_local_to_global(cell_system.rhs,
+                                                      cell_system.dof_indices,
+                                                      mesh_rhs,
+                                                      lifting ?
+                                                        cell_system.matrix :
+                                                        no_matrix);
+        }
+    mesh_rhs.compress(VectorOperation::add);
+  }
+
+
+
+  template <int dim>
   typename CoupledSystem<dim>::VectorType
   CoupledSystem<dim>::tension_scaling(const IndexSet &active_set) const
   {
@@ -132,6 +149,102 @@ namespace membranes
       entry = 1 / std::sqrt(entry);
     scaling.compress(VectorOperation::insert);
     return scaling;
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::make_system(const IndexSet   &active_set,
+                                  const VectorType &scaling)
+  {
+    const MeshOperator<dim> &mesh             = *this->mesh;
+    const auto              &laplace_diagonal = mesh.laplace_diagonal();
+    const MatrixRows         operator_rows(mesh.stiffness_matrix());
+    const MatrixRows         rows(this->system_matrix);
+
+    // The contact lines: the u1 column of an active vertex goes to its u2
+    // column, and the row of u2 of an owned active vertex also takes the
+    // row of u1. The owner of a vertex tells the columns (u2's index + 1
+    // in u1's entry, 0 for an inactive vertex): with hanging vertices, the
+    // operator's rows can have columns of vertices that lie on no cell of
+    // this process.
+    VectorType u2_of_active_u1(mesh.locally_owned_dofs(),
+                               this->mpi_communicator);
+    std::vector<types::global_dof_index> contact_row(
+      rows.n_rows(), numbers::invalid_dof_index);
+    for (const auto &dofs : mesh.locally_relevant_vertices())
+      if (active_set.is_element(dofs[0]))
+        {
+          if (mesh.locally_owned_dofs().is_element(dofs[0]))
+            u2_of_active_u1[dofs[0]] = dofs[1] + 1.;
+          const int r = rows.local_row(dofs[1]);
+          if (r >= 0)
+            contact_row[r] = dofs[0];
+        }
+    u2_of_active_u1.compress(VectorOperation::insert);
+    const VectorType u2_of_column =
+      on_columns_of(mesh.stiffness_matrix(), u2_of_active_u1);
+    std::vector<int> column = column_of_operator_column;
+    for (unsigned int c = 0; c < operator_rows.n_columns(); ++c)
+      if (const double u2 = u2_of_column[operator_rows.global_column(c)];
+          u2 > 0)
+        column[c] =
+          rows.local_column(static_cast<types::global_dof_index>(u2) - 1);
+
+    const VectorType ghosted_scaling =
+      on_columns_of(this->system_matrix, scaling);
+    std::vector<double> column_scaling(rows.n_columns());
+    for (unsigned int c = 0; c < rows.n_columns(); ++c)
+      column_scaling[c] = ghosted_scaling[rows.global_column(c)];
+
+    std::vector<int> position(rows.n_columns(), -1);
+    for (unsigned int r = 0; r < rows.n_rows(); ++r)
+      {
+        const auto   i           = rows.global_row(r);
+        const auto   row         = rows[r];
+        const double row_scaling = scaling[i];
+        if (mesh_constraints.is_constrained(i) || active_set.is_element(i))
+          {
+            // A constrained row keeps the diagonal Σ_K μ_i A_K(i, i).
+            for (unsigned int e = 0; e < row.values.size(); ++e)
+              row.values[e] = (rows.global_column(row.columns[e]) == i) ?
+                                tension[i] * laplace_diagonal[i] *
+                                  (row_scaling * row_scaling) :
+                                0.;
+            this->system_rhs[i] = 0;
+            continue;
+          }
+        for (unsigned int e = 0; e < row.values.size(); ++e)
+          {
+            position[row.columns[e]] = e;
+            row.values[e]            = 0;
+          }
+        // Row j of the mesh's operator and of its right-hand side; the
+        // columns of constrained DoFs, not in the system's pattern, are
+        // lifted in mesh_rhs.
+        double     rhs     = 0;
+        const auto add_row = [&](const types::global_dof_index j) {
+          const auto operator_row = operator_rows[operator_rows.local_row(j)];
+          rhs += mesh_rhs[j];
+          for (unsigned int e = 0; e < operator_row.values.size(); ++e)
+            {
+              const int c = column[operator_row.columns[e]];
+              if (c >= 0 && position[c] >= 0)
+                row.values[position[c]] += operator_row.values[e];
+            }
+        };
+        add_row(i);
+        if (contact_row[r] != numbers::invalid_dof_index)
+          add_row(contact_row[r]);
+        for (unsigned int e = 0; e < row.values.size(); ++e)
+          {
+            row.values[e] *= row_scaling * column_scaling[row.columns[e]];
+            position[row.columns[e]] = -1;
+          }
+        this->system_rhs[i] = rhs * row_scaling;
+      }
+    this->system_rhs.compress(VectorOperation::insert);
   }
 
 
@@ -159,23 +272,6 @@ namespace membranes
       constraints.close();
       constraints.distribute(solution);
 
-      this->system_matrix = 0;
-      this->system_rhs    = 0;
-      CellSystem<dim> cell_system(this->discretization, this->data);
-      for (const auto &cell : mesh.get_dof_handler().active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            cell_system.reinit_operator(cell);
-            cell_system.set_loads(mesh.cell_loads(cell));
-            constraints.distribute_local_to_global(cell_system.matrix,
-                                                   cell_system.rhs,
-                                                   cell_system.dof_indices,
-                                                   this->system_matrix,
-                                                   this->system_rhs);
-          }
-      this->system_matrix.compress(VectorOperation::add);
-      this->system_rhs.compress(VectorOperation::add);
-
       // The system scaled by D = diag(m_j^{-1/2}), m_j = μ_i for the DoFs
       // of membrane i at inactive vertices and on ∂ω, μ1 + μ2 for both
       // DoFs of an active vertex. Its residual D r then has the norm
@@ -183,9 +279,7 @@ namespace membranes
       // only r_S), so one bound on it bounds r_S and r_W each on its own
       // scale.
       scaling = tension_scaling(active_set);
-      scale_symmetrically(this->system_matrix,
-                          column_scaling(this->system_matrix, scaling));
-      this->system_rhs.scale(scaling);
+      make_system(active_set, scaling);
     }
 
     const double tolerance =
@@ -210,6 +304,8 @@ namespace membranes
     ActiveSetSystem<dim>::clear();
     tension.clear();
     constraints.clear();
+    mesh_rhs.clear();
+    column_of_operator_column = {};
   }
 
 

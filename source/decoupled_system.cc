@@ -1,7 +1,7 @@
-#include <Epetra_CrsMatrix.h>
+#include <algorithm>
 #include <deal.II/dofs/dof_tools.h>
-#include <membranes/cell_loop.h>
 #include <membranes/decoupled_system.h>
+#include <membranes/matrix_rows.h>
 
 namespace membranes
 {
@@ -34,55 +34,6 @@ namespace membranes
               cell->index(),
               &dof_handler};
     }
-
-
-
-    /**
-     * @p matrix = @p coefficient · @p base with the off-diagonal entries of
-     * the rows and columns of @p eliminated (locally relevant DoFs) set to
-     * zero: the condensation of the homogeneous constraints x_k = 0, k in
-     * @p eliminated, on the locally owned rows of a matrix with the
-     * sparsity pattern of @p base, in one pass over its entries.
-     */
-    void
-    eliminate_rows_and_columns(const TrilinosWrappers::SparseMatrix &base,
-                               const double                    coefficient,
-                               const IndexSet                 &eliminated,
-                               TrilinosWrappers::SparseMatrix &matrix)
-    {
-      // Epetra's row views point into the matrices' storage, writable even
-      // through a const matrix: the values of @p matrix are overwritten in
-      // place, its pattern (that of @p base) stays.
-      const Epetra_CrsMatrix &from = base.trilinos_matrix();
-      const Epetra_CrsMatrix &to   = matrix.trilinos_matrix();
-      std::vector<bool>       eliminated_column(from.NumMyCols());
-      for (int c = 0; c < from.NumMyCols(); ++c)
-        eliminated_column[c] = eliminated.is_element(from.GCID64(c));
-      for (int row = 0; row < from.NumMyRows(); ++row)
-        {
-          int     n_entries, n_target_entries;
-          double *values, *target_values;
-          int    *columns, *target_columns;
-          from.ExtractMyRowView(row, n_entries, values, columns);
-          to.ExtractMyRowView(row,
-                              n_target_entries,
-                              target_values,
-                              target_columns);
-          AssertDimension(n_entries, n_target_entries);
-          const auto global_row     = from.GRID64(row);
-          const bool eliminated_row = eliminated.is_element(global_row);
-          for (int k = 0; k < n_entries; ++k)
-            {
-              Assert(columns[k] == target_columns[k], ExcInternalError());
-              const bool off_diagonal = (from.GCID64(columns[k]) != global_row);
-              target_values[k] =
-                (off_diagonal &&
-                 (eliminated_row || eliminated_column[columns[k]])) ?
-                  0. :
-                  coefficient * values[k];
-            }
-        }
-    }
   } // namespace
 
 
@@ -113,8 +64,6 @@ namespace membranes
   {
     this->mesh                         = &mesh_operator;
     const DoFHandler<dim> &dof_handler = mesh_operator.get_dof_handler();
-    const IndexSet        &locally_relevant_dofs =
-      mesh_operator.locally_relevant_dofs();
     scalar_dof_handler.reinit(dof_handler.get_triangulation());
     scalar_dof_handler.distribute_dofs(
       this->discretization.fe->base_element(0));
@@ -122,31 +71,24 @@ namespace membranes
     DoFTools::extract_locally_relevant_dofs(scalar_dof_handler,
                                             locally_relevant_scalar_dofs);
 
-    // Shape function v of the scalar element and shape function
-    // component_to_system_index(i, v) of the FESystem belong to the same
-    // vertex of a cell.
+    // Both DoFHandlers number the vertices in the same order, the FESystem
+    // the DoFs of u1 and u2 at a vertex one after the other: the DoFs of
+    // scalar DoF k are 2k and 2k + 1 (membrane_dof()). Checked here on the
+    // cells of this process.
     const FiniteElement<dim>            &fe = *this->discretization.fe;
     std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
     std::vector<types::global_dof_index> scalar_dof_indices(
       fe.base_element(0).n_dofs_per_cell());
-    membrane_dofs.resize(locally_owned_scalar_dofs.n_elements());
-    scalar_dof.resize(locally_relevant_dofs.n_elements());
     for (const auto &scalar_cell : scalar_dof_handler.active_cell_iterators())
-      if (!scalar_cell->is_artificial())
+      if (scalar_cell->is_locally_owned())
         {
           scalar_cell->get_dof_indices(scalar_dof_indices);
           cell_of(dof_handler, scalar_cell)->get_dof_indices(dof_indices);
           for (unsigned int v = 0; v < scalar_dof_indices.size(); ++v)
             for (unsigned int i = 0; i < 2; ++i)
-              {
-                const auto k = scalar_dof_indices[v];
-                const auto dof =
-                  dof_indices[fe.component_to_system_index(i, v)];
-                if (locally_owned_scalar_dofs.is_element(k))
-                  membrane_dofs[locally_owned_scalar_dofs.index_within_set(k)]
-                               [i] = dof;
-                scalar_dof[locally_relevant_dofs.index_within_set(dof)] = k;
-              }
+              AssertThrow(dof_indices[fe.component_to_system_index(i, v)] ==
+                            membrane_dof(scalar_dof_indices[v], i),
+                          ExcInternalError());
         }
 
     // Both scalar problems have the hanging node constraints and boundary
@@ -154,24 +96,39 @@ namespace membranes
     // condensed operator A for both. W = 0 on active vertices only removes
     // couplings, so the pattern of A holds the matrix of W for every active
     // set.
+    AffineConstraints<double> hanging_node_constraints(
+      locally_relevant_scalar_dofs);
+    DoFTools::make_hanging_node_constraints(scalar_dof_handler,
+                                            hanging_node_constraints);
+    hanging_node_constraints.close();
     this->make_mesh_constraints(scalar_dof_handler,
+                                hanging_node_constraints,
                                 *sum_boundary_values,
-                                locally_relevant_scalar_dofs,
                                 sum_constraints);
     this->make_mesh_constraints(scalar_dof_handler,
+                                hanging_node_constraints,
                                 *difference_boundary_values,
-                                locally_relevant_scalar_dofs,
                                 difference_constraints);
     this->reinit_linear_system(scalar_dof_handler,
                                sum_constraints,
                                locally_owned_scalar_dofs,
                                locally_relevant_scalar_dofs);
-    laplace_matrix.reinit(this->system_matrix);
+    constrained_scalar_dofs = IndexSet(scalar_dof_handler.n_dofs());
+    for (const auto &line : sum_constraints.get_lines())
+      constrained_scalar_dofs.add_index(line.index);
+    constrained_scalar_dofs.compress();
+
+    // The matrix of S, then that of W of the iteration that builds the AMG
+    // hierarchy; the matrix of W of an iteration that reuses the hierarchy
+    // is made by solve() when it is first needed.
     preconditioner_matrix.reinit(this->system_matrix);
-    // The matrix of W of an iteration that reuses the AMG hierarchy is made
-    // by solve() when it is first needed, after the hierarchy is built.
     this->system_matrix.clear();
-    sum_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
+    const MatrixRows operator_rows(mesh_operator.stiffness_matrix());
+    const MatrixRows rows(preconditioner_matrix);
+    column_of_operator_column.resize(operator_rows.n_columns());
+    for (unsigned int c = 0; c < operator_rows.n_columns(); ++c)
+      column_of_operator_column[c] =
+        rows.local_column(operator_rows.global_column(c) / 2);
     difference_rhs.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     sum.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
     difference.reinit(locally_owned_scalar_dofs, this->mpi_communicator);
@@ -181,69 +138,147 @@ namespace membranes
 
 
   template <int dim>
-  void
-  DecoupledSystem<dim>::assemble_operator()
+  types::global_dof_index
+  DecoupledSystem<dim>::membrane_dof(const types::global_dof_index k,
+                                     const unsigned int            i)
   {
-    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double M = mu1 + mu2;
-    // A_K, the loads of S and of W and the scalar DoFs of a cell, computed
-    // on threads; the copier adds them to the global systems.
-    struct CellContribution
-    {
-      FullMatrix<double>                   laplace_matrix, difference_matrix;
-      Vector<double>                       sum_loads, difference_loads;
-      std::vector<types::global_dof_index> scalar_dof_indices;
+    return 2 * k + i;
+  }
+
+
+
+  template <int dim>
+  void
+  DecoupledSystem<dim>::make_right_hand_sides()
+  {
+    // The loads of S, F_1K + F_2K, and of W, (μ2 F_1K − μ1 F_2K)/M, of each
+    // cell from the loads of the mesh, condensed by AffineConstraints as in
+    // an assembly. The cell matrix (A_K for S, μ̄ A_K for W) is needed only
+    // where a DoF of the cell has an inhomogeneous constraint (a boundary
+    // value to lift); a cell without constrained DoFs adds its loads.
+    // AffineConstraints condenses the right-hand side of S together with
+    // its matrix; what it adds to the matrix of S here, make_operator()
+    // overwrites.
+    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double       M = mu1 + mu2;
+    const unsigned int n_vertices =
+      this->discretization.fe->base_element(0).n_dofs_per_cell();
+    CellSystem<dim>    cell_system(this->discretization, this->data);
+    FullMatrix<double> laplace_matrix(n_vertices),
+      difference_matrix(n_vertices);
+    Vector<double> sum_loads(n_vertices), difference_loads(n_vertices);
+    std::vector<types::global_dof_index> scalar_dof_indices(n_vertices);
+    const auto is_constrained = [&](const types::global_dof_index k) {
+      return constrained_scalar_dofs.is_element(k);
+    };
+    const auto lifts = [&](const types::global_dof_index k) {
+      return sum_constraints.is_inhomogeneously_constrained(k) ||
+             difference_constraints.is_inhomogeneously_constrained(k);
     };
 
-    laplace_matrix = 0;
-    sum_rhs        = 0;
-    difference_rhs = 0;
-    run_on_cells<CellContribution>(
-      this->mesh->get_dof_handler(),
-      [&]() {
-        return std::make_unique<CellSystem<dim>>(this->discretization,
-                                                 this->data);
-      },
-      [&](const auto       &cell,
-          CellSystem<dim>  &cell_system,
-          CellContribution &contribution) {
-        contribution.scalar_dof_indices.clear();
-        if (!cell->is_locally_owned())
-          return;
-        cell_system.reinit_operator(cell);
-        cell_system.set_loads(this->mesh->cell_loads(cell));
-        contribution.scalar_dof_indices.resize(cell_system.laplace_matrix.m());
-        cell_of(scalar_dof_handler, cell)
-          ->get_dof_indices(contribution.scalar_dof_indices);
-        contribution.laplace_matrix = cell_system.laplace_matrix;
-        contribution.sum_loads      = cell_system.loads[0];
-        contribution.sum_loads.add(1., cell_system.loads[1]);
-        // The loads of W, with its boundary values lifted by the cell
-        // matrix of its system, μ̄ A_K.
-        contribution.difference_matrix = cell_system.laplace_matrix;
-        contribution.difference_matrix *= this->data.mu_bar;
-        contribution.difference_loads = cell_system.loads[0];
-        contribution.difference_loads *= mu2 / M;
-        contribution.difference_loads.add(-mu1 / M, cell_system.loads[1]);
-      },
-      [&](const CellContribution &contribution) {
-        if (contribution.scalar_dof_indices.empty())
-          return;
-        sum_constraints.distribute_local_to_global(
-          contribution.laplace_matrix,
-          contribution.sum_loads,
-          contribution.scalar_dof_indices,
-          laplace_matrix,
-          sum_rhs);
-        difference_constraints.distribute_local_to_global(
-          contribution.difference_loads,
-          contribution.scalar_dof_indices,
-          difference_rhs,
-          contribution.difference_matrix);
-      });
-    laplace_matrix.compress(VectorOperation::add);
-    sum_rhs.compress(VectorOperation::add);
+    this->system_rhs = 0;
+    difference_rhs   = 0;
+    for (const auto &cell :
+         this->mesh->get_dof_handler().active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell_of(scalar_dof_handler, cell)
+            ->get_dof_indices(scalar_dof_indices);
+          cell_system.set_loads(this->mesh->cell_loads(cell));
+          sum_loads = cell_system.loads[0];
+          sum_loads.add(1., cell_system.loads[1]);
+          difference_loads = cell_system.loads[0];
+          difference_loads *= mu2 / M;
+          difference_loads.add(-mu1 / M, cell_system.loads[1]);
+          if (std::none_of(scalar_dof_indices.begin(),
+                           scalar_dof_indices.end(),
+                           is_constrained))
+            {
+              this->system_rhs.add(scalar_dof_indices, sum_loads);
+              difference_rhs.add(scalar_dof_indices, difference_loads);
+              continue;
+            }
+          if (std::any_of(scalar_dof_indices.begin(),
+                          scalar_dof_indices.end(),
+                          lifts))
+            {
+              cell_system.reinit_operator(cell);
+              laplace_matrix    = cell_system.laplace_matrix;
+              difference_matrix = cell_system.laplace_matrix;
+              difference_matrix *= this->data.mu_bar;
+            }
+          else
+            {
+              laplace_matrix    = 0;
+              difference_matrix = 0;
+            }
+          sum_constraints.distribute_local_to_global(laplace_matrix,
+                                                     sum_loads,
+                                                     scalar_dof_indices,
+                                                     preconditioner_matrix,
+                                                     this->system_rhs);
+          difference_constraints.distribute_local_to_global(difference_loads,
+                                                            scalar_dof_indices,
+                                                            difference_rhs,
+                                                            difference_matrix);
+        }
+    preconditioner_matrix.compress(VectorOperation::add);
+    this->system_rhs.compress(VectorOperation::add);
     difference_rhs.compress(VectorOperation::add);
+  }
+
+
+
+  template <int dim>
+  void
+  DecoupledSystem<dim>::make_operator(
+    const double                    coefficient,
+    const IndexSet                 &active_scalar_dofs,
+    TrilinosWrappers::SparseMatrix &matrix) const
+  {
+    // Row a of A is row a of the block μ1 A of the mesh's operator divided
+    // by μ1, restricted to the unconstrained columns (those of the pattern
+    // of @p matrix); a constrained row keeps only the diagonal that the
+    // condensation leaves, Σ_K A_K(a, a).
+    const double      mu1              = this->data.mu[0];
+    const auto       &laplace_diagonal = this->mesh->laplace_diagonal();
+    const MatrixRows  operator_rows(this->mesh->stiffness_matrix());
+    const MatrixRows  rows(matrix);
+    std::vector<bool> active_column(rows.n_columns());
+    for (unsigned int c = 0; c < rows.n_columns(); ++c)
+      active_column[c] = active_scalar_dofs.is_element(rows.global_column(c));
+    std::vector<int> position(rows.n_columns(), -1);
+    for (const auto k : locally_owned_scalar_dofs)
+      {
+        const auto row = rows[rows.local_row(k)];
+        if (constrained_scalar_dofs.is_element(k))
+          {
+            AssertDimension(row.values.size(), 1);
+            row.values[0] = coefficient * laplace_diagonal[membrane_dof(k, 0)];
+            continue;
+          }
+        for (unsigned int e = 0; e < row.values.size(); ++e)
+          {
+            position[row.columns[e]] = e;
+            row.values[e]            = 0;
+          }
+        const bool active_row = active_scalar_dofs.is_element(k);
+        const auto operator_row =
+          operator_rows[operator_rows.local_row(membrane_dof(k, 0))];
+        for (unsigned int e = 0; e < operator_row.values.size(); ++e)
+          {
+            const int c = column_of_operator_column[operator_row.columns[e]];
+            if (c < 0 || position[c] < 0)
+              continue;
+            const bool off_diagonal = (rows.global_column(c) != k);
+            row.values[position[c]] =
+              (off_diagonal && (active_row || active_column[c])) ?
+                0. :
+                coefficient * (operator_row.values[e] / mu1);
+          }
+        for (const int c : row.columns)
+          position[c] = -1;
+      }
   }
 
 
@@ -257,11 +292,10 @@ namespace membranes
     {
       TimerOutput::Scope scope(this->timer, "assembly");
       const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-      for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+      for (const auto k : locally_owned_scalar_dofs)
         {
-          const auto   k  = locally_owned_scalar_dofs.nth_index_in_set(j);
-          const double u1 = solution[membrane_dofs[j][0]];
-          const double u2 = solution[membrane_dofs[j][1]];
+          const double u1 = solution[membrane_dof(k, 0)];
+          const double u2 = solution[membrane_dof(k, 1)];
           sum[k]          = mu1 * u1 + mu2 * u2;
           difference[k]   = u1 - u2;
         }
@@ -269,11 +303,14 @@ namespace membranes
       difference.compress(VectorOperation::insert);
 
       sum_constraints.distribute(sum);
-      assemble_operator();
+      make_right_hand_sides();
+      make_operator(1.,
+                    IndexSet(scalar_dof_handler.n_dofs()),
+                    preconditioner_matrix);
     }
 
-    this->solve_linear_system(laplace_matrix,
-                              sum_rhs,
+    this->solve_linear_system(preconditioner_matrix,
+                              this->system_rhs,
                               sum_constraints,
                               sum,
                               tolerances.sum,
@@ -292,16 +329,14 @@ namespace membranes
   {
     if (!sum_solved)
       solve_sum(solution, tolerances, statistics);
-    const IndexSet &locally_relevant_dofs = this->mesh->locally_relevant_dofs();
-    const double    mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double    M = mu1 + mu2;
+    const double       mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double       M = mu1 + mu2;
     TimerOutput::Scope assembly(this->timer, "assembly");
 
     // The scalar DoFs of the active vertices; W = 0 there.
     IndexSet active_scalar_dofs(scalar_dof_handler.n_dofs());
     for (const auto dof : active_set)
-      active_scalar_dofs.add_index(
-        scalar_dof[locally_relevant_dofs.index_within_set(dof)]);
+      active_scalar_dofs.add_index(dof / 2);
     active_scalar_dofs.compress();
     const IndexSet owned_active_scalar_dofs =
       active_scalar_dofs & locally_owned_scalar_dofs;
@@ -321,11 +356,8 @@ namespace membranes
     TrilinosWrappers::SparseMatrix &matrix =
       builds_preconditioner ? preconditioner_matrix : this->system_matrix;
     if (matrix.m() == 0)
-      matrix.reinit(laplace_matrix);
-    eliminate_rows_and_columns(laplace_matrix,
-                               this->data.mu_bar,
-                               active_scalar_dofs,
-                               matrix);
+      matrix.reinit(preconditioner_matrix);
+    make_operator(this->data.mu_bar, active_scalar_dofs, matrix);
     this->system_rhs = difference_rhs;
     set_active_to_zero(this->system_rhs);
     set_active_to_zero(difference);
@@ -345,11 +377,10 @@ namespace membranes
     TimerOutput::Scope scope(this->timer, "solve");
     set_active_to_zero(difference);
     difference_constraints.distribute(difference);
-    for (unsigned int j = 0; j < membrane_dofs.size(); ++j)
+    for (const auto k : locally_owned_scalar_dofs)
       {
-        const auto k = locally_owned_scalar_dofs.nth_index_in_set(j);
-        solution[membrane_dofs[j][0]] = (sum[k] + mu2 * difference[k]) / M;
-        solution[membrane_dofs[j][1]] = (sum[k] - mu1 * difference[k]) / M;
+        solution[membrane_dof(k, 0)] = (sum[k] + mu2 * difference[k]) / M;
+        solution[membrane_dof(k, 1)] = (sum[k] - mu1 * difference[k]) / M;
       }
     solution.compress(VectorOperation::insert);
   }
@@ -361,14 +392,13 @@ namespace membranes
   DecoupledSystem<dim>::clear()
   {
     ActiveSetSystem<dim>::clear();
-    laplace_matrix.clear();
     preconditioner_matrix.clear();
-    for (VectorType *vector : {&sum_rhs, &difference_rhs, &sum, &difference})
+    for (VectorType *vector : {&difference_rhs, &sum, &difference})
       vector->clear();
     sum_constraints.clear();
     difference_constraints.clear();
-    membrane_dofs = {};
-    scalar_dof    = {};
+    column_of_operator_column = {};
+    constrained_scalar_dofs.clear();
     scalar_dof_handler.clear();
   }
 

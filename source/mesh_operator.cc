@@ -1,10 +1,10 @@
-#include <Epetra_CrsMatrix.h>
 #include <algorithm>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <membranes/cell_loop.h>
 #include <membranes/cell_system.h>
+#include <membranes/matrix_rows.h>
 #include <membranes/mesh_operator.h>
 
 namespace membranes
@@ -58,9 +58,9 @@ namespace membranes
     loads.reinit(locally_owned_dofs, mpi_communicator);
 
     VectorType dual_cell_measure(locally_owned_dofs, mpi_communicator);
-    VectorType stiffness_diagonal(locally_owned_dofs, mpi_communicator);
-    assemble(dual_cell_measure, stiffness_diagonal);
-    find_vertices(dual_cell_measure, stiffness_diagonal);
+    diagonal.reinit(locally_owned_dofs, mpi_communicator);
+    assemble(dual_cell_measure, diagonal);
+    find_vertices(dual_cell_measure, diagonal);
   }
 
 
@@ -153,20 +153,12 @@ namespace membranes
     candidates.erase(std::unique(candidates.begin(), candidates.end()),
                      candidates.end());
 
-    // The row of the assembled operator, read in place (deal.II's row
-    // iterators copy every row they visit).
-    const Epetra_CrsMatrix &epetra = matrix.trilinos_matrix();
-    const auto row_l1_norm         = [&](const types::global_dof_index row) {
-      int     n_entries;
-      double *values;
-      int    *columns;
-      epetra.ExtractMyRowView(epetra.LRID(static_cast<long long>(row)),
-                              n_entries,
-                              values,
-                              columns);
+    // The row of the assembled operator, read in place.
+    const MatrixRows rows(matrix);
+    const auto       row_l1_norm = [&](const types::global_dof_index row) {
       double norm = 0;
-      for (int k = 0; k < n_entries; ++k)
-        norm += std::abs(values[k]);
+      for (const double value : rows[rows.local_row(row)].values)
+        norm += std::abs(value);
       return norm;
     };
 
@@ -246,6 +238,15 @@ namespace membranes
   MeshOperator<dim>::stiffness_matrix() const
   {
     return matrix;
+  }
+
+
+
+  template <int dim>
+  const typename MeshOperator<dim>::VectorType &
+  MeshOperator<dim>::laplace_diagonal() const
+  {
+    return diagonal;
   }
 
 

@@ -133,16 +133,17 @@ namespace membranes
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * Hanging node constraints of @p dof_handler and @p boundary_values,
-     * interpolated at its boundary vertices on all of ∂ω, into
-     * @p constraints (closed): what is constrained on every iteration of a
-     * mesh.
+     * @p hanging_node_constraints (closed) of @p dof_handler and
+     * @p boundary_values, interpolated at its boundary vertices on all of
+     * ∂ω, into @p constraints (closed): what is constrained on every
+     * iteration of a mesh.
      */
     void
-    make_mesh_constraints(const DoFHandler<dim>     &dof_handler,
-                          const Function<dim>       &boundary_values,
-                          const IndexSet            &locally_relevant_dofs,
-                          AffineConstraints<double> &constraints) const;
+    make_mesh_constraints(
+      const DoFHandler<dim>           &dof_handler,
+      const AffineConstraints<double> &hanging_node_constraints,
+      const Function<dim>             &boundary_values,
+      AffineConstraints<double>       &constraints) const;
 
     /**
      * Choose the linear solver for @p dof_handler, and size the matrix and

@@ -30,10 +30,12 @@ namespace membranes
    *   matrix(j, k) = μ_c A_K(v(j), v(k))  if c(j) = c(k), 0 otherwise,
    *   rhs(j)       = F_cK(v(j)),    lumped_mass(j) = m_K(v(j)).
    *
-   * The coupled active set solver assembles its system from the FESystem
-   * parts, the decoupled one its scalar systems from A_K and F_iK, and the
-   * discrete action evaluates the residual of (4.5) as matrix U_K − rhs:
-   * all see the same bilinear form and the same quadrature of the loads.
+   * MeshOperator assembles the operator and the loads of the mesh from the
+   * FESystem parts, once per mesh, and keeps the loads F_iK of each cell;
+   * the systems of the active set method condense the loads of each cell
+   * (the coupled one from the FESystem parts, the decoupled one from F_iK)
+   * and take their matrices from the mesh's operator: all see the same
+   * bilinear form and the same quadrature of the loads.
    */
   template <int dim>
   class CellSystem
@@ -49,8 +51,8 @@ namespace membranes
 
     /**
      * The same without the loads (`loads` and `rhs` are left as they are):
-     * what does not evaluate the data, for a system whose loads were
-     * computed once per mesh.
+     * what does not evaluate the data, for a right-hand side whose loads
+     * were computed once per mesh.
      */
     void
     reinit_operator(const typename DoFHandler<dim>::active_cell_iterator &cell);

@@ -4,6 +4,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <membranes/active_set_system.h>
+#include <vector>
 
 namespace membranes
 {
@@ -19,9 +20,12 @@ namespace membranes
    * Condensing the constraint adds the equations of u1 and u2 at a, so the
    * solution of each iteration satisfies Prop. 12 (λ from either membrane)
    * by construction; on inactive vertices both equations hold, i.e.
-   * λ_a = 0. The condensed system changes with the active set and is
-   * assembled at every iteration from the cell matrices of CellSystem and
-   * the cell loads, which are computed once per mesh.
+   * λ_a = 0. The Laplacian is not assembled again: the condensed system of
+   * an iteration is made in one pass over the entries of the operator of
+   * the mesh (MeshOperator) and of its loads, condensed once per mesh with
+   * the hanging node constraints and boundary values; per iteration only
+   * the contact lines of the active set are condensed, as AffineConstraints
+   * would condense them in an assembly.
    *
    * The rows of the two membranes are forces of tensions μ1 and μ2, and of
    * μ1 + μ2 where the contact constraint adds them: for tension ratios far
@@ -69,12 +73,39 @@ namespace membranes
     VectorType
     tension_scaling(const IndexSet &active_set) const;
 
+    /** mesh_rhs, from the loads of the mesh's cells. */
+    void
+    make_mesh_rhs();
+
+    /**
+     * The system matrix and right-hand side of @p active_set, condensed
+     * with the constraints of the mesh and the contact lines and scaled
+     * symmetrically by @p scaling: in each locally owned unconstrained row
+     * i the rows of the mesh's operator of i and, if i is the u2 DoF of an
+     * active vertex, of its u1 DoF, the columns of u1 DoFs of active
+     * vertices moved to their u2 DoFs, and the same rows of mesh_rhs; a
+     * constrained row (boundary, hanging, or u1 of an active vertex) keeps
+     * only the diagonal Σ_K μ_i A_K(i, i), and zero on the right.
+     */
+    void
+    make_system(const IndexSet &active_set, const VectorType &scaling);
+
     /** Hanging node and boundary constraints of the mesh. */
     AffineConstraints<double> mesh_constraints;
     /** The same with the contact lines of the current active set. */
     AffineConstraints<double> constraints;
     /** μ_i at each locally owned DoF of membrane i. */
     VectorType tension;
+    /**
+     * The loads condensed with mesh_constraints (boundary values lifted),
+     * zero in constrained rows: made once per mesh.
+     */
+    VectorType mesh_rhs;
+    /**
+     * For each local column of the mesh's operator, the local column of the
+     * system matrix (−1 if none).
+     */
+    std::vector<int> column_of_operator_column;
   };
 } // namespace membranes
 

@@ -6,6 +6,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <membranes/active_set_system.h>
+#include <membranes/matrix_rows.h>
 #include <memory>
 #include <vector>
 
@@ -47,26 +48,28 @@ namespace membranes
    * problem, on the unconstrained interior vertices.
    *
    * <h3>What one iteration does</h3>
-   * The first solve() of a mesh assembles the operator A (condensed with
-   * the hanging node constraints and the boundary values, which are the
-   * same lines for S and for W) and the right-hand sides of S and W, and
-   * solves the linear problem for S from the initial guess. Every solve()
-   * then imposes W_a = 0 on the active
-   * set: in the matrix μ̄ A the rows and columns of the active vertices are
+   * The Laplacian is not assembled again: A is the block μ1 A of the
+   * operator of the mesh (MeshOperator) divided by μ1. The first solve() of
+   * a mesh condenses the cell loads of the mesh into the right-hand sides
+   * of S and W (the boundary values lifted by A_K and μ̄ A_K on the cells
+   * at ∂ω; the hanging node constraints and the boundary values are the
+   * same lines for S and for W) and solves the linear problem for S from
+   * the initial guess. Every
+   * solve() then imposes W_a = 0 on the active set: it writes μ̄ A into the
+   * matrix of W with the rows and columns of the active vertices
    * eliminated (what condensing an AffineConstraints line without entries
-   * does), the right-hand side is zeroed there; it solves the obstacle
-   * problem's linear system for W (inactive vertices: Λ_a = 0), and writes
-   * U1, U2 into the solution of the two-component FESystem. Nothing is
-   * assembled and no data are evaluated per iteration. ActiveSetSolver computes
-   * λ_a by (4.5), and ActiveSet the next active set and the KKT residual,
-   * from it exactly as for the coupled system: the test Λ_a − c_a W_a > 0 with
-   * c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of this obstacle problem, whose
-   * diagonal is μ̄ A_aa.
+   * does), the right-hand side zeroed there, in one pass over the entries
+   * of the mesh's operator; it solves the obstacle problem's linear system
+   * for W (inactive vertices: Λ_a = 0), and writes U1, U2 into the
+   * solution of the two-component FESystem. ActiveSetSolver computes λ_a by
+   * (4.5), and ActiveSet the next active set and the KKT residual, from it
+   * exactly as for the coupled system: the test Λ_a − c_a W_a > 0 with
+   * c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of this obstacle problem,
+   * whose diagonal is μ̄ A_aa.
    *
    * Both scalar problems live on one scalar DoFHandler (the base element of
-   * the FESystem, on the same mesh and mapping) and are assembled from the
-   * same cell matrices A_K and loads F_iK as the coupled system
-   * (CellSystem). Each is half the size of the coupled system, and S is
+   * the FESystem, on the same mesh and mapping), whose DoFs map one to one
+   * to the vertices. Each is half the size of the coupled system, and S is
    * solved only once.
    */
   template <int dim>
@@ -82,17 +85,17 @@ namespace membranes
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * The scalar DoFHandler on the mesh of @p mesh_operator, the map between
-     * its DoFs and those of (u1, u2), the constraints of S and of W, and one
-     * sparsity pattern for S and for W with any active set.
+     * The scalar DoFHandler on the mesh of @p mesh_operator, the constraints
+     * of S and of W, and one sparsity pattern for S and for W with any
+     * active set.
      */
     void
     setup(const MeshOperator<dim> &mesh_operator) override;
 
     /**
      * W for @p active_set, and (U1, U2) from S and W into @p solution. The
-     * first solve on a mesh first assembles A and the right-hand sides, and
-     * solves for S (solve_sum()).
+     * first solve on a mesh first makes the right-hand sides and solves for
+     * S (solve_sum()).
      */
     void
     solve(const IndexSet         &active_set,
@@ -101,25 +104,44 @@ namespace membranes
           ActiveSetStatistics    &statistics) override;
 
     /**
-     * Also the scalar DoFHandler, its constraints, A, the matrix of W, S, W,
-     * their right-hand sides and the maps between the DoFs.
+     * Also the scalar DoFHandler, its constraints, the matrices of W, S, W
+     * and the right-hand side of W.
      */
     void
     clear() override;
 
   private:
     /**
-     * The operator A and the right-hand sides of S and of W (without the
-     * contact constraints) on this mesh, condensed with the hanging node
-     * constraints and the boundary values of each.
+     * The DoF of u_i (i = 0, 1) at the vertex of scalar DoF @p k; the
+     * scalar DoF of a DoF j of (u1, u2) is j / 2.
      */
-    void
-    assemble_operator();
+    static types::global_dof_index
+    membrane_dof(const types::global_dof_index k, const unsigned int i);
 
     /**
-     * S and W of the initial guess @p solution, the operator and the
-     * right-hand sides (assemble_operator()), then S of this mesh, from
-     * A S = F1 + F2.
+     * The right-hand sides of S (into system_rhs) and of W (without the
+     * contact constraints), condensed with the hanging node constraints and
+     * the boundary values of each, from the loads and the operator of the
+     * mesh.
+     */
+    void
+    make_right_hand_sides();
+
+    /**
+     * @p matrix = @p coefficient · A, condensed with the hanging node
+     * constraints and the boundary values, and with the rows and columns of
+     * @p active_scalar_dofs (locally relevant) eliminated: their
+     * off-diagonal entries zero. @p matrix has the sparsity pattern that
+     * setup() made.
+     */
+    void
+    make_operator(const double                    coefficient,
+                  const IndexSet                 &active_scalar_dofs,
+                  TrilinosWrappers::SparseMatrix &matrix) const;
+
+    /**
+     * S and W of the initial guess @p solution, the right-hand sides
+     * (make_right_hand_sides()), then S of this mesh, from A S = F1 + F2.
      */
     void
     solve_sum(const VectorType       &solution,
@@ -133,34 +155,29 @@ namespace membranes
     DoFHandler<dim> scalar_dof_handler;
     IndexSet        locally_owned_scalar_dofs;
     IndexSet        locally_relevant_scalar_dofs;
-    /**
-     * The DoFs of u1 and u2 at the vertex of each locally owned scalar DoF,
-     * by its position in locally_owned_scalar_dofs. (A vertex has the same
-     * owner in both DoFHandlers: the same rule on the same mesh.)
-     */
-    std::vector<std::array<types::global_dof_index, 2>> membrane_dofs;
-    /**
-     * The scalar DoF of each locally relevant DoF of (u1, u2), by its
-     * position in locally_relevant_dofs.
-     */
-    std::vector<types::global_dof_index> scalar_dof;
 
     /** Hanging node constraints and the boundary values of S, of W. */
     AffineConstraints<double> sum_constraints;
     AffineConstraints<double> difference_constraints;
+    /** The scalar DoFs these constrain (the same for S and W). */
+    IndexSet constrained_scalar_dofs;
 
     /**
-     * A, the Laplacian on the scalar space, and the loads of S (F1 + F2) and
-     * of W ((μ2 F1 − μ1 F2)/M, its boundary values lifted by μ̄ A),
-     * condensed with the constraints of the mesh: assembled once per mesh.
+     * The local column of the matrices of S and W of each local column of
+     * the mesh's operator (−1 where they have none).
      */
-    TrilinosWrappers::SparseMatrix laplace_matrix;
-    VectorType                     sum_rhs;
-    VectorType                     difference_rhs;
+    std::vector<int> column_of_operator_column;
 
     /**
-     * The matrix of W at the iteration whose AMG hierarchy the following
-     * iterations of this mesh reuse (LinearSolver).
+     * The load of W ((μ2 F1 − μ1 F2)/M, its boundary values lifted by μ̄ A),
+     * condensed with the constraints of the mesh: made once per mesh.
+     */
+    VectorType difference_rhs;
+
+    /**
+     * The matrix of S, then that of W at the iteration whose AMG hierarchy
+     * the following iterations of this mesh reuse (LinearSolver); those
+     * write theirs into system_matrix.
      */
     TrilinosWrappers::SparseMatrix preconditioner_matrix;
 

@@ -35,6 +35,7 @@ namespace membranes
    * - the cell loads F_1K, F_2K (and the mean and oscillation of each load
    *   on K) in the layout of CellSystem::copy_loads(), so that no system
    *   evaluates the data again on this mesh;
+   * - the diagonal Σ_K A_K(j, j) of the Laplacian, not condensed;
    * - the set V_h of the unconstrained interior vertices with, for each
    *   locally owned one, d_a = ∫ φ_a (the lumped mass of (4.17); with
    *   hanging nodes the row sum of the constrained mass matrix), ∫|∇φ_a|²
@@ -94,6 +95,16 @@ namespace membranes
     /** μ_i A on each membrane (condensed with the hanging node constraints). */
     const TrilinosWrappers::SparseMatrix &
     stiffness_matrix() const;
+
+    /**
+     * Σ_K A_K(j, j) = ∫ |∇φ_j|² at each locally owned DoF j, summed over
+     * its cells without μ_i and without condensation: the diagonal entry
+     * that AffineConstraints leaves in the row of a constrained DoF j when
+     * it assembles the Laplacian (the systems of the active set method
+     * eliminate the rows of constrained DoFs so).
+     */
+    const VectorType &
+    laplace_diagonal() const;
 
     /** The loads (∫ f_i φ)_φ, condensed likewise. */
     const VectorType &
@@ -162,6 +173,7 @@ namespace membranes
     MPI_Comm                                      mpi_communicator;
 
     TrilinosWrappers::SparseMatrix matrix;
+    VectorType                     diagonal;
     VectorType                     loads;
     /**
      * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
