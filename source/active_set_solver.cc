@@ -28,8 +28,8 @@ namespace membranes
      * The linear problem of one iteration, as `Solver/Method` asks; `auto`
      * is the decoupled one, faster on every scene measured
      * (benchmarks/solver_cost.sh): its systems are half the size of the
-     * coupled one, S is solved once per mesh, and its operator is assembled
-     * once per mesh.
+     * coupled one, S is solved once per mesh, and its operators are taken
+     * from the mesh's operator (MeshOperator) without a new assembly.
      */
     template <int dim>
     std::unique_ptr<ActiveSetSystem<dim>>
