@@ -235,8 +235,6 @@ namespace membranes
     if (cell_type == Parameters::CellType::quadrilateral)
       return std::make_unique<parallel::distributed::Triangulation<dim>>(
         mpi_communicator);
-    if (getenv("SERIALTEST"))
-      return std::make_unique<Triangulation<dim>>();
     return std::make_unique<parallel::shared::Triangulation<dim>>(
       mpi_communicator,
       Triangulation<dim>::none,
