@@ -30,10 +30,7 @@ namespace membranes
         scalar_index.push_back(component_and_index.second);
       }
     for (unsigned int i = 0; i < 2; ++i)
-      {
-        loads[i].reinit(laplace_matrix.m());
-        load_values[i].resize(fe_values.n_quadrature_points);
-      }
+      loads[i].reinit(laplace_matrix.m());
   }
 
 
@@ -44,25 +41,25 @@ namespace membranes
     const typename DoFHandler<dim>::active_cell_iterator &cell)
   {
     reinit_operator(cell);
+    data.load_list(fe_values.get_quadrature_points(), load_values);
     for (unsigned int i = 0; i < 2; ++i)
       {
-        data.load(i).value_list(fe_values.get_quadrature_points(),
-                                load_values[i]);
-        loads[i]       = 0;
+        const std::vector<double> &f = load_values.f[i];
+        loads[i]                     = 0;
         double measure = 0, integral = 0;
         for (const unsigned int q : fe_values.quadrature_point_indices())
           {
             measure += fe_values.JxW(q);
-            integral += load_values[i][q] * fe_values.JxW(q);
+            integral += f[q] * fe_values.JxW(q);
             for (const unsigned int v : fe_values.dof_indices())
-              loads[i](v) += load_values[i][q] * fe_values.shape_value(v, q) *
-                             fe_values.JxW(q);
+              loads[i](v) +=
+                f[q] * fe_values.shape_value(v, q) * fe_values.JxW(q);
           }
         load_mean[i]        = integral / measure;
         load_oscillation[i] = 0;
         for (const unsigned int q : fe_values.quadrature_point_indices())
           load_oscillation[i] +=
-            std::pow(load_values[i][q] - load_mean[i], 2) * fe_values.JxW(q);
+            std::pow(f[q] - load_mean[i], 2) * fe_values.JxW(q);
       }
     for (unsigned int j = 0; j < dof_indices.size(); ++j)
       rhs(j) = loads[membrane[j]](scalar_index[j]);

@@ -205,10 +205,12 @@ namespace membranes
   CompiledFunctions::CompiledFunctions(
     const std::vector<Request>          &requests,
     const std::vector<std::string>      &variables,
-    const std::map<std::string, double> &constants)
+    const std::map<std::string, double> &constants,
+    const std::vector<Group>            &groups)
   {
-    const auto        start  = std::chrono::steady_clock::now();
-    const std::string source = generated_source(requests, variables, constants);
+    const auto        start = std::chrono::steady_clock::now();
+    const std::string source =
+      generated_source(requests, variables, constants, groups);
     const std::string target = cache_directory() + "/expressions-" +
                                hash(source + compiler_identity(compiler())) +
                                ".so";
@@ -276,5 +278,14 @@ namespace membranes
   {
     return reinterpret_cast<Value>(
       symbol("membranes_laplacian_" + std::to_string(i)));
+  }
+
+
+
+  CompiledFunctions::GroupValues
+  CompiledFunctions::group(const unsigned int g) const
+  {
+    return reinterpret_cast<GroupValues>(
+      symbol("membranes_group_" + std::to_string(g)));
   }
 } // namespace membranes

@@ -34,19 +34,16 @@ namespace membranes
                    update_JxW_values)
       {
         const unsigned int n_q_points = values.fe_values.n_quadrature_points;
-        lambda.resize(n_q_points);
         for (unsigned int i = 0; i < 2; ++i)
           {
             uh[i].resize(n_q_points);
-            u[i].resize(n_q_points);
             grad_uh[i].resize(n_q_points);
-            grad_u[i].resize(n_q_points);
           }
       }
       DualCellValues<dim>                        values;
-      std::array<std::vector<double>, 2>         uh, u;
-      std::array<std::vector<Tensor<1, dim>>, 2> grad_uh, grad_u;
-      std::vector<double>                        lambda;
+      std::array<std::vector<double>, 2>         uh;
+      std::array<std::vector<Tensor<1, dim>>, 2> grad_uh;
+      typename ProblemData<dim>::ExactValues     exact;
     };
     // Squared norms on one cell, and summed over the locally owned cells.
     using Squares = std::array<double, 5>;
@@ -70,10 +67,9 @@ namespace membranes
               scratch.values.local_dofs, scratch.uh[i]);
             fe_values[membrane].get_function_gradients_from_local_dof_values(
               scratch.values.local_dofs, scratch.grad_uh[i]);
-            data.exact_displacement(i).value_list(points, scratch.u[i]);
-            data.exact_displacement(i).gradient_list(points, scratch.grad_u[i]);
           }
-        data.exact_lambda().value_list(points, scratch.lambda);
+        data.exact_solution_list(points, scratch.exact);
+        const auto &exact = scratch.exact;
 
         for (const unsigned int q : fe_values.quadrature_point_indices())
           {
@@ -81,15 +77,14 @@ namespace membranes
             for (unsigned int i = 0; i < 2; ++i)
               {
                 cell_squares[i] +=
-                  (scratch.grad_u[i][q] - scratch.grad_uh[i][q]).norm_square() *
+                  (exact.grad_u[i][q] - scratch.grad_uh[i][q]).norm_square() *
                   JxW;
                 cell_squares[2 + i] +=
-                  std::pow(scratch.u[i][q] - scratch.uh[i][q], 2) * JxW;
+                  std::pow(exact.u[i][q] - scratch.uh[i][q], 2) * JxW;
               }
             if (scratch.values.in_omega_h[q])
               cell_squares[4] +=
-                std::pow(scratch.lambda[q] - scratch.values.lambda_h[q], 2) *
-                JxW;
+                std::pow(exact.lambda[q] - scratch.values.lambda_h[q], 2) * JxW;
           }
       },
       [&](const Squares &cell_squares) {

@@ -78,7 +78,6 @@ namespace membranes
                   update_values | update_gradients | update_jacobians |
                     update_quadrature_points | update_JxW_values)
       , volume_points(points.n_volume)
-      , load(points.n_volume)
     {
       for (auto &gradient : gradients)
         gradient.resize(points.quadrature.size());
@@ -89,7 +88,7 @@ namespace membranes
     /** ∇u_ih at the points. */
     std::array<std::vector<Tensor<1, dim>>, 2> gradients;
     std::vector<Point<dim>>                    volume_points;
-    std::vector<double>                        load;
+    typename ProblemData<dim>::LoadValues      load;
     /** f_i at the points of the dual quadrature, in load_at_points. */
     std::array<const double *, 2> loads;
   };
@@ -251,12 +250,12 @@ namespace membranes
         ghosted_solution, scratch.gradients[i]);
     for (unsigned int q = 0; q < n_volume; ++q)
       scratch.volume_points[q] = scratch.fe_values.quadrature_point(q);
+    data.load_list(scratch.volume_points, scratch.load);
     for (unsigned int i = 0; i < 2; ++i)
       {
-        data.load(i).value_list(scratch.volume_points, scratch.load);
         const auto begin = load_at_points.begin() +
                            (2 * cell->active_cell_index() + i) * n_volume;
-        std::copy(scratch.load.begin(), scratch.load.end(), begin);
+        std::copy(scratch.load.f[i].begin(), scratch.load.f[i].end(), begin);
         scratch.loads[i] = &*begin;
       }
     for (unsigned int s = 0; s < n_triangles; ++s)

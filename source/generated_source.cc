@@ -218,8 +218,59 @@ namespace
   {
     return round_int(value(a)) != 0;
   }
+
+  // The variables at the point p as dual numbers: v[d] is x_d with the
+  // derivative 1 by x_d (by x_d at both levels for the second derivatives).
+  MEMBRANES_INLINE void seed(const double *p, Dual<double> *v)
+  {
+    for (int d = 0; d < n; ++d) { v[d].v = p[d]; v[d].d[d] = 1; }
+  }
+  MEMBRANES_INLINE void seed(const double *p, Dual<Dual<double>> *v)
+  {
+    for (int d = 0; d < n; ++d) { v[d].v.v = p[d]; v[d].v.d[d] = 1; v[d].d[d].v = 1; }
+  }
+  MEMBRANES_INLINE double laplacian(const Dual<Dual<double>> &r)
+  {
+    double sum = 0;
+    for (int d = 0; d < n; ++d) sum += r.d[d].d[d];
+    return sum;
+  }
 }
 )";
+
+    /**
+     * The body of group @p group's loop over the points, at the point p:
+     * each member evaluated in the number type its derivatives need, and
+     * written to out.
+     */
+    std::string
+    group_member_lines(const CompiledFunctions::Group &group)
+    {
+      std::ostringstream out;
+      for (const CompiledFunctions::Member &member : group)
+        {
+          const std::string e =
+            "expression_" + std::to_string(member.expression);
+          if (member.laplacian)
+            out << "    {\n      Dual<Dual<double>> v[n];\n      seed(p, v);\n"
+                << "      const Dual<Dual<double>> r = " << e << "(v);\n"
+                << "      *out++ = r.v.v;\n"
+                << (member.gradient ?
+                      "      for (int d = 0; d < n; ++d) *out++ = r.v.d[d];\n" :
+                      "")
+                << "      *out++ = laplacian(r);\n    }\n";
+          else if (member.gradient)
+            out
+              << "    {\n      Dual<double> v[n];\n      seed(p, v);\n"
+              << "      const Dual<double> r = " << e << "(v);\n"
+              << "      *out++ = r.v;\n"
+              << "      for (int d = 0; d < n; ++d) *out++ = r.d[d];\n    }\n";
+          else
+            out << "    *out++ = " << e << "(p);\n";
+        }
+      return out.str();
+    }
+
   } // namespace
 
 
@@ -227,7 +278,8 @@ namespace
   std::string
   generated_source(const std::vector<CompiledFunctions::Request> &requests,
                    const std::vector<std::string>                &variables,
-                   const std::map<std::string, double>           &constants)
+                   const std::map<std::string, double>           &constants,
+                   const std::vector<CompiledFunctions::Group>   &groups)
   {
     const std::string  n = std::to_string(variables.size());
     std::ostringstream out;
@@ -247,22 +299,24 @@ namespace
         if (requests[i].gradient)
           out << "extern \"C\" void membranes_gradient_" << s
               << "(const double *p, double *g) {\n"
-              << "  Dual<double> v[n];\n"
-              << "  for (int d = 0; d < n; ++d) { v[d].v = p[d]; "
-                 "v[d].d[d] = 1; }\n"
+              << "  Dual<double> v[n];\n  seed(p, v);\n"
               << "  const Dual<double> r = " << e << "(v);\n"
               << "  for (int d = 0; d < n; ++d) g[d] = r.d[d];\n}\n";
         if (requests[i].laplacian)
           out << "extern \"C\" double membranes_laplacian_" << s
               << "(const double *p) {\n"
-              << "  Dual<Dual<double>> v[n];\n"
-              << "  for (int d = 0; d < n; ++d) { v[d].v.v = p[d]; "
-                 "v[d].v.d[d] = 1; v[d].d[d].v = 1; }\n"
-              << "  const Dual<Dual<double>> r = " << e << "(v);\n"
-              << "  double laplacian = 0;\n"
-              << "  for (int d = 0; d < n; ++d) laplacian += r.d[d].d[d];\n"
-              << "  return laplacian;\n}\n";
+              << "  Dual<Dual<double>> v[n];\n  seed(p, v);\n"
+              << "  return laplacian(" << e << "(v));\n}\n";
       }
+    // One loop per group over its points: the members are inlined into
+    // the same body, where the compiler computes what they share once.
+    for (unsigned int g = 0; g < groups.size(); ++g)
+      out << "extern \"C\" void membranes_group_" << g
+          << "(const double *points, const unsigned int n_points, "
+             "double *out) {\n"
+          << "  for (unsigned int q = 0; q < n_points; ++q) {\n"
+          << "    const double *p = points + n * q;\n"
+          << group_member_lines(groups[g]) << "  }\n}\n";
     return out.str();
   }
 } // namespace membranes

@@ -60,6 +60,33 @@ namespace membranes
         }
       return constants;
     }
+
+
+    /** The position of @p expression among the expressions of @p scene. */
+    template <typename Scene, typename Expression>
+    unsigned int
+    position(const Scene &scene, const Expression *expression)
+    {
+      return static_cast<unsigned int>(
+        std::find_if(scene.begin(),
+                     scene.end(),
+                     [&](const auto &e) { return e.first == expression; }) -
+        scene.begin());
+    }
+
+
+    /**
+     * The manufactured load of membrane @p i (0 or 1) of tension @p mu from
+     * its Laplacian Δu_i and λ: f1 = −μ1Δu1 − λ, f2 = −μ2Δu2 + λ.
+     */
+    double
+    manufactured_load(const unsigned int i,
+                      const double       mu,
+                      const double       laplacian,
+                      const double       lambda)
+    {
+      return -mu * laplacian + (i == 0 ? -1. : 1.) * lambda;
+    }
   } // namespace
 
 
@@ -138,13 +165,27 @@ namespace membranes
       compiled_gradient = gradient;
     }
 
+    /** Check @p value at @p p as value() checks its own. */
+    void
+    check(const double value, const Point<dim> &p) const
+    {
+      checks.check(value, p, "value");
+    }
+
+    /** Check @p gradient at @p p as gradient() checks its own. */
+    void
+    check(const Tensor<1, dim> &gradient, const Point<dim> &p) const
+    {
+      checks.check(gradient, p);
+    }
+
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
       if (!compiled_value)
         return parsers().value(p);
       const double result = compiled_value(p);
-      checks.check(result, p, "value");
+      check(result, p);
       return result;
     }
 
@@ -157,7 +198,7 @@ namespace membranes
         for (unsigned int q = 0; q < points.size(); ++q)
           {
             values[q] = compiled_value(points[q]);
-            checks.check(values[q], points[q], "value");
+            check(values[q], points[q]);
           }
       else
         {
@@ -173,7 +214,7 @@ namespace membranes
       if (!compiled_gradient)
         return parsers().gradient(p);
       const Tensor<1, dim> result = compiled_gradient(p);
-      checks.check(result, p);
+      check(result, p);
       return result;
     }
 
@@ -186,7 +227,7 @@ namespace membranes
         for (unsigned int q = 0; q < points.size(); ++q)
           {
             gradients[q] = compiled_gradient(points[q]);
-            checks.check(gradients[q], points[q]);
+            check(gradients[q], points[q]);
           }
       else
         {
@@ -349,6 +390,7 @@ namespace membranes
     : mu{{problem.mu1, problem.mu2}}
     , mu_bar(problem.mu1 * problem.mu2 / (problem.mu1 + problem.mu2))
     , known(exact.known)
+    , manufactured(exact.manufactured)
   {
     const auto constants = parse_constants(problem);
     // The expressions of the scene, each parsed (a syntax error is an
@@ -443,9 +485,30 @@ namespace membranes
     std::vector<CompiledFunctions::Request> requests;
     for (const auto &expression : scene)
       requests.push_back(expression.second);
-    compiled = std::make_unique<CompiledFunctions>(requests,
+    // The error norms want u1, u2 with their gradients and λ at the same
+    // points: one group.
+    // The loads at the same points: f1 and f2, or what the manufactured
+    // loads are made of. The error norms want u1, u2 with their gradients
+    // and λ at the same points.
+    std::vector<CompiledFunctions::Group> groups;
+    if (manufactured)
+      groups.push_back({{position(scene, exact_u[0].get()), false, true},
+                        {position(scene, exact_u[1].get()), false, true},
+                        {position(scene, exact_action.get())}});
+    else
+      groups.push_back(
+        {{position(scene, f[0].get())}, {position(scene, f[1].get())}});
+    if (known)
+      groups.push_back({{position(scene, exact_u[0].get()), true},
+                        {position(scene, exact_u[1].get()), true},
+                        {position(scene, exact_action.get())}});
+    compiled    = std::make_unique<CompiledFunctions>(requests,
                                                    variable_names<dim>(),
-                                                   all_constants);
+                                                   all_constants,
+                                                   groups);
+    loads_group = compiled->group(0);
+    if (known)
+      exact_group = compiled->group(1);
     for (unsigned int i = 0; i < scene.size(); ++i)
       {
         const CompiledFunctions::Value value = compiled->value(i);
@@ -475,29 +538,21 @@ namespace membranes
     const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
       &scene)
   {
-    const auto index = [&](const Expression *expression) {
-      return static_cast<unsigned int>(
-        std::find_if(scene.begin(),
-                     scene.end(),
-                     [&](const auto &e) { return e.first == expression; }) -
-        scene.begin());
-    };
     const CompiledFunctions::Value lambda =
-      compiled->value(index(exact_action.get()));
+      compiled->value(position(scene, exact_action.get()));
     const std::string entry = "Exact solution/Manufactured data";
     for (unsigned int i = 0; i < 2; ++i)
       {
-        const unsigned int             u         = index(exact_u[i].get());
+        const unsigned int             u = position(scene, exact_u[i].get());
         const CompiledFunctions::Value laplacian = compiled->laplacian(u);
         const CompiledFunctions::Value value     = compiled->value(u);
-        const double                   sign      = (i == 0 ? -1. : 1.);
         const std::string              n         = std::to_string(i + 1);
         f[i]                                     = std::make_unique<Expression>(
           entry,
           "f" + n + " = -mu" + n + " Laplace(u" + n + ") " +
             (i == 0 ? "-" : "+") + " lambda",
-          [laplacian, lambda, sign, mu = mu[i]](const Point<dim> &p) {
-            return -mu * laplacian(&p[0]) + sign * lambda(&p[0]);
+          [laplacian, lambda, i, mu = mu[i]](const Point<dim> &p) {
+            return manufactured_load(i, mu, laplacian(&p[0]), lambda(&p[0]));
           });
         (i == 0 ? g : g2) = std::make_unique<Expression>(
           "Exact solution/u" + n,
@@ -514,10 +569,39 @@ namespace membranes
 
 
   template <int dim>
-  const Function<dim> &
-  ProblemData<dim>::load(const unsigned int i) const
+  void
+  ProblemData<dim>::load_list(const std::vector<Point<dim>> &points,
+                              LoadValues                    &values) const
   {
-    return *f[i];
+    const unsigned int n_points = points.size();
+    for (unsigned int i = 0; i < 2; ++i)
+      values.f[i].resize(n_points);
+    if (loads_group == nullptr)
+      {
+        for (unsigned int i = 0; i < 2; ++i)
+          f[i]->value_list(points, values.f[i]);
+        return;
+      }
+
+    // Per point f1, f2; with manufactured data u1, Δu1, u2, Δu2, λ.
+    static_assert(sizeof(Point<dim>) == dim * sizeof(double));
+    const unsigned int n_values = manufactured ? 5 : 2;
+    values.group_values.resize(n_points * n_values);
+    loads_group(&points[0][0], n_points, values.group_values.data());
+    for (unsigned int q = 0; q < n_points; ++q)
+      {
+        const double *group_value = &values.group_values[q * n_values];
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            values.f[i][q] = manufactured ?
+                               manufactured_load(i,
+                                                 mu[i],
+                                                 group_value[2 * i + 1],
+                                                 group_value[4]) :
+                               group_value[i];
+            f[i]->check(values.f[i][q], points[q]);
+          }
+      }
   }
 
 
@@ -589,7 +673,7 @@ namespace membranes
                   u->value(p);
                   u->gradient(p);
                 }
-              exact_lambda().value(p);
+              exact_action->value(p);
               check_gradient_entries(p);
             }
         }
@@ -646,21 +730,48 @@ namespace membranes
 
 
   template <int dim>
-  const Function<dim> &
-  ProblemData<dim>::exact_displacement(const unsigned int i) const
+  void
+  ProblemData<dim>::exact_solution_list(const std::vector<Point<dim>> &points,
+                                        ExactValues &values) const
   {
     Assert(known, ExcInternalError());
-    return *exact_u[i];
-  }
+    const unsigned int n_points = points.size();
+    values.lambda.resize(n_points);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        values.u[i].resize(n_points);
+        values.grad_u[i].resize(n_points);
+      }
+    if (exact_group == nullptr)
+      {
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            exact_u[i]->value_list(points, values.u[i]);
+            exact_u[i]->gradient_list(points, values.grad_u[i]);
+          }
+        exact_action->value_list(points, values.lambda);
+        return;
+      }
 
-
-
-  template <int dim>
-  const Function<dim> &
-  ProblemData<dim>::exact_lambda() const
-  {
-    Assert(known, ExcInternalError());
-    return *exact_action;
+    // The group reads the points as dim coordinates each, one point after
+    // the other, and writes per point u1, ∇u1, u2, ∇u2, λ.
+    static_assert(sizeof(Point<dim>) == dim * sizeof(double));
+    values.group_values.resize(n_points * (2 * (1 + dim) + 1));
+    exact_group(&points[0][0], n_points, values.group_values.data());
+    const double *group_value = values.group_values.data();
+    for (unsigned int q = 0; q < n_points; ++q)
+      {
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            values.u[i][q] = *group_value++;
+            for (unsigned int d = 0; d < dim; ++d)
+              values.grad_u[i][q][d] = *group_value++;
+            exact_u[i]->check(values.u[i][q], points[q]);
+            exact_u[i]->check(values.grad_u[i][q], points[q]);
+          }
+        values.lambda[q] = *group_value++;
+        exact_action->check(values.lambda[q], points[q]);
+      }
   }
 
 

@@ -3,7 +3,9 @@
 // the grammar: the same values to round-off (1e-13 relative) at a few
 // points; and their derivatives by dual numbers against finite differences
 // of the values: gradients to 1e-6, Laplacians to 1e-4 relative to the
-// size of the second derivatives (the error of the differences).
+// size of the second derivatives (the error of the differences). Then all
+// of them as one group, at all points in one call, against the functions
+// of each expression: the same numbers, in the group's order, to 1e-14.
 
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
@@ -43,10 +45,19 @@ main(int argc, char **argv)
                                      Point<2>(-0.45, 0.61),
                                      Point<2>(0.77, 0.12)};
 
+  // Every expression with both derivatives; in the group, the members ask
+  // for none, the gradient, the Laplacian or both, in turn.
   std::vector<membranes::CompiledFunctions::Request> requests;
-  for (const auto &expression : expressions)
-    requests.push_back({expression, true, true});
-  const membranes::CompiledFunctions compiled(requests, {"x", "y"}, constants);
+  membranes::CompiledFunctions::Group                group;
+  for (unsigned int i = 0; i < expressions.size(); ++i)
+    {
+      requests.push_back({expressions[i], true, true});
+      group.push_back({i, i % 2 == 1, i % 4 >= 2});
+    }
+  const membranes::CompiledFunctions compiled(requests,
+                                              {"x", "y"},
+                                              constants,
+                                              {group});
 
   unsigned int failures = 0;
   const auto   compare  = [&](const std::string &what,
@@ -107,6 +118,34 @@ main(int argc, char **argv)
                   1e-4 * scale);
         }
     }
+
+  std::vector<double> group_values(points.size() * 4 * expressions.size());
+  compiled.group(0)(&points[0][0], points.size(), group_values.data());
+  const double *group_value = group_values.data();
+  for (const Point<2> &p : points)
+    for (const auto &member : group)
+      {
+        const std::string &expression = expressions[member.expression];
+        const auto same = [&](const std::string &what, const double expected) {
+          compare("group " + what,
+                  expression,
+                  p,
+                  *group_value++,
+                  expected,
+                  1e-14 * std::max(1., std::abs(expected)));
+        };
+        same("value", compiled.value(member.expression)(&p[0]));
+        if (member.gradient)
+          {
+            double gradient[2];
+            compiled.gradient(member.expression)(&p[0], gradient);
+            same("derivative 0", gradient[0]);
+            same("derivative 1", gradient[1]);
+          }
+        if (member.laplacian)
+          same("Laplacian", compiled.laplacian(member.expression)(&p[0]));
+      }
+
   std::cout << (failures == 0 ? "PASS" : "FAIL") << ": " << expressions.size()
             << " expressions at " << points.size() << " points, "
             << (compiled.compiled_now ? "compiled" : "from the cache") << " in "

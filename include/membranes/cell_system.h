@@ -96,12 +96,12 @@ namespace membranes
     scalar_index_of(const unsigned int j) const;
 
   private:
-    const ProblemData<dim>            &data;
-    FEValues<dim>                      fe_values;
-    std::vector<unsigned int>          membrane;
-    std::vector<unsigned int>          scalar_index;
-    std::array<std::vector<double>, 2> load_values;
-    Vector<double>                     scalar_lumped_mass;
+    const ProblemData<dim>               &data;
+    FEValues<dim>                         fe_values;
+    std::vector<unsigned int>             membrane;
+    std::vector<unsigned int>             scalar_index;
+    typename ProblemData<dim>::LoadValues load_values;
+    Vector<double>                        scalar_lumped_mass;
   };
 } // namespace membranes
 

@@ -22,6 +22,12 @@ namespace membranes
    * for the Laplacian (the sum of the second derivatives ∂²/∂x_d²), exact to
    * round-off where the expression is differentiable, with no step size.
    *
+   * Expressions that are wanted at the same points (the exact solution
+   * u1, u2 and λ in the error norms) can be asked for as one group: one
+   * generated loop over the points evaluates all of them, so that the
+   * compiler computes their common subexpressions once (cos(πx/2) of both
+   * u1 and u2, say) and a list of points costs one call.
+   *
    * The shared object is cached under cache_directory(), named by a hash of
    * the generated source and of the compiler: a later run with the same
    * expressions loads it without compiling. It is written under a temporary
@@ -53,19 +59,41 @@ namespace membranes
       bool        laplacian = false;
     };
 
+    /** One expression of a group, and which of its derivatives are wanted. */
+    struct Member
+    {
+      unsigned int expression;
+      bool         gradient  = false;
+      bool         laplacian = false;
+    };
+
+    /** Expressions evaluated together at the same points. */
+    using Group = std::vector<Member>;
+
     /** The value at the point p (its dim coordinates). */
     using Value = double (*)(const double *p);
     /** The dim derivatives at p, written to gradient. */
     using Gradient = void (*)(const double *p, double *gradient);
+    /**
+     * A group at @p n_points points (dim coordinates each, one after the
+     * other), written to @p values: for each point, for each member in
+     * turn, its value, then its dim derivatives and its Laplacian where
+     * asked for.
+     */
+    using GroupValues = void (*)(const double      *points,
+                                 const unsigned int n_points,
+                                 double            *values);
 
     /**
      * Translate @p requests, expressions in the variables @p variables with
-     * the named @p constants (substituted by their values), and compile and
-     * load them (or load them from the cache). Throws Unavailable.
+     * the named @p constants (substituted by their values), with the
+     * @p groups of them evaluated together, and compile and load them (or
+     * load them from the cache). Throws Unavailable.
      */
     CompiledFunctions(const std::vector<Request>          &requests,
                       const std::vector<std::string>      &variables,
-                      const std::map<std::string, double> &constants);
+                      const std::map<std::string, double> &constants,
+                      const std::vector<Group>            &groups = {});
 
     ~CompiledFunctions();
 
@@ -84,6 +112,10 @@ namespace membranes
     /** The Laplacian of expression @p i; only if requested. */
     Value
     laplacian(const unsigned int i) const;
+
+    /** Group @p g. */
+    GroupValues
+    group(const unsigned int g) const;
 
     /**
      * Whether the shared object was compiled by this run (false: found in

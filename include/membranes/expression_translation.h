@@ -32,12 +32,14 @@ namespace membranes
    * functions of the grammar), one function template per expression
    * (translate_expression()), and the entry points (extern "C", so that
    * dlsym finds them by name) membranes_value_i, membranes_gradient_i and
-   * membranes_laplacian_i, the latter two where requested.
+   * membranes_laplacian_i, the latter two where requested, and
+   * membranes_group_g for each of @p groups.
    */
   std::string
   generated_source(const std::vector<CompiledFunctions::Request> &requests,
                    const std::vector<std::string>                &variables,
-                   const std::map<std::string, double>           &constants);
+                   const std::map<std::string, double>           &constants,
+                   const std::vector<CompiledFunctions::Group>   &groups);
 } // namespace membranes
 
 #endif

@@ -1,6 +1,7 @@
 #ifndef membranes_problem_data_h
 #define membranes_problem_data_h
 
+#include <array>
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/function.h>
 #include <deal.II/fe/mapping.h>
@@ -8,6 +9,7 @@
 #include <membranes/compiled_function.h>
 #include <membranes/parameters.h>
 #include <memory>
+#include <vector>
 
 namespace membranes
 {
@@ -63,9 +65,23 @@ namespace membranes
 
     ~ProblemData();
 
-    /** Load f_i of membrane i (i = 0 or 1 for membranes 1 and 2). */
-    const Function<dim> &
-    load(const unsigned int i) const;
+    /** The loads at a list of points. */
+    struct LoadValues
+    {
+      /** f_i at each point (i = 0 or 1 for membranes 1 and 2). */
+      std::array<std::vector<double>, 2> f;
+      /** The compiled group's values, kept between calls. */
+      std::vector<double> group_values;
+    };
+
+    /**
+     * The loads f1, f2 at @p points, into @p values (resized to them).
+     * With compiled expressions one call evaluates both together at all
+     * points (with manufactured data, the Laplacians of u1 and u2 and λ
+     * they are made of), each value checked as value() checks it.
+     */
+    void
+    load_list(const std::vector<Point<dim>> &points, LoadValues &values) const;
 
     /**
      * The boundary values as one function with two components (g, g2), as
@@ -112,16 +128,31 @@ namespace membranes
     void
     set_gradient_step(const double step) const;
 
-    /**
-     * Exact displacement u_i (i = 0 or 1), with its gradient; only when
-     * known.
-     */
-    const Function<dim> &
-    exact_displacement(const unsigned int i) const;
+    /** The exact solution at a list of points. */
+    struct ExactValues
+    {
+      /** u_i at each point (i = 0 or 1 for membranes 1 and 2). */
+      std::array<std::vector<double>, 2> u;
+      /** ∇u_i at each point. */
+      std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+      /** λ at each point. */
+      std::vector<double> lambda;
+      /** The compiled group's values, kept between calls. */
+      std::vector<double> group_values;
+    };
 
-    /** Exact action λ; only when known. */
-    const Function<dim> &
-    exact_lambda() const;
+    /**
+     * The exact solution u1, u2, their gradients and λ at @p points, into
+     * @p values (resized to them); only when known. With compiled
+     * expressions one call evaluates all of them together at all points
+     * (CompiledFunctions::Group), so that what u1 and u2 share (u1 = u2 +
+     * a gap, say) is computed once, and the gradients come with the values
+     * from the same dual numbers. Every value is checked as value() checks
+     * it.
+     */
+    void
+    exact_solution_list(const std::vector<Point<dim>> &points,
+                        ExactValues                   &values) const;
 
     /** μ1 and μ2 as `mu[0]`, `mu[1]`. */
     const std::array<double, 2> mu;
@@ -149,12 +180,25 @@ namespace membranes
 
     std::unique_ptr<CompiledFunctions> compiled;
 
+    /**
+     * The compiled group of u1 and u2 (each value and gradient) and λ, when
+     * the exact solution is known and compiled.
+     */
+    CompiledFunctions::GroupValues exact_group = nullptr;
+
+    /**
+     * The compiled group of the loads: f1 and f2, or with manufactured data
+     * u1 and u2 (each value and Laplacian) and λ.
+     */
+    CompiledFunctions::GroupValues loads_group = nullptr;
+
     std::array<std::unique_ptr<Expression>, 2> f;
     std::unique_ptr<Expression>                g;
     std::unique_ptr<Expression>                g2;
     std::unique_ptr<Function<dim>>             g_and_g2;
 
     const bool                                 known;
+    const bool                                 manufactured;
     std::array<std::unique_ptr<Expression>, 2> exact_u;
     std::unique_ptr<Expression>                exact_action;
   };
