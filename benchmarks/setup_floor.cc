@@ -2,7 +2,7 @@
  * The floor of the setup of one cycle of case M, measured with deal.II's
  * building blocks alone.
  *
- *   setup_floor [refinements]
+ *   setup_floor [refinements] [components|full]
  *
  * One cycle of the active set method on a new mesh needs, before its first
  * linear solve: the refined mesh with the previous solution carried over
@@ -20,6 +20,13 @@
  * previous cycle; the measured cycle is the next one (1024 × 1024 cells,
  * 2 101 250 DoFs). After each step the program reads the peak resident set
  * size (VmHWM) and the current one (VmRSS) of the process.
+ *
+ * The matrix couples the DoFs of a cell in the way of membranes'
+ * MeshOperator, each component only with itself (`components`, the
+ * default: the least that the active set method needs on a mesh), or in
+ * the way of its CoupledSystem, every DoF with every other (`full`: the
+ * matrix that the yardstick of solver_cost.sh solves with, whose u1–u2
+ * entries stay zero without contact).
  */
 
 #include <algorithm>
@@ -50,8 +57,10 @@
 #include <deal.II/numerics/vector_tools.h>
 #include <iomanip>
 #include <iostream>
+#include <malloc.h>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -135,7 +144,7 @@ namespace setup_floor
   class SetupFloor
   {
   public:
-    explicit SetupFloor(const unsigned int refinements);
+    SetupFloor(const unsigned int refinements, const bool full_coupling);
 
     void
     run();
@@ -177,6 +186,7 @@ namespace setup_floor
                 const unsigned int cg_iterations) const;
 
     const unsigned int                        refinements;
+    const bool                                full_coupling;
     MPI_Comm                                  mpi_communicator;
     parallel::distributed::Triangulation<dim> triangulation;
     const FESystem<dim>                       fe;
@@ -206,8 +216,10 @@ namespace setup_floor
 
 
 
-  SetupFloor::SetupFloor(const unsigned int refinements)
+  SetupFloor::SetupFloor(const unsigned int refinements,
+                         const bool         full_coupling)
     : refinements(refinements)
+    , full_coupling(full_coupling)
     , mpi_communicator(MPI_COMM_WORLD)
     , triangulation(mpi_communicator)
     , fe(FE_Q<dim>(1), 2)
@@ -393,15 +405,25 @@ namespace setup_floor
 
 
   /**
-   * The matrix of the coupled system, as membranes' CoupledSystem makes it:
-   * every DoF of a cell coupled with every other (the contact lines couple
-   * u1 and u2), condensed with the constraints.
+   * The sparsity pattern, condensed with the constraints, and the matrix:
+   * each component coupled with itself, or every DoF of a cell with every
+   * other (the contact lines of membranes' CoupledSystem couple u1 and
+   * u2).
    */
   void
   SetupFloor::setup_matrix()
   {
     DynamicSparsityPattern dsp(locally_relevant_dofs);
-    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+    if (full_coupling)
+      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+    else
+      {
+        Table<2, DoFTools::Coupling> coupling(2, 2);
+        coupling(0, 0) = DoFTools::always;
+        coupling(1, 1) = DoFTools::always;
+        DoFTools::make_sparsity_pattern(
+          dof_handler, coupling, dsp, constraints, false);
+      }
     SparsityTools::distribute_sparsity_pattern(dsp,
                                                locally_owned_dofs,
                                                mpi_communicator,
@@ -546,13 +568,18 @@ namespace setup_floor
 
 
 
-  /** The linear system of a mesh is freed once the mesh is solved on. */
+  /**
+   * The linear system of a mesh is freed once the mesh is solved on; the
+   * memory goes back to the system (glibc's malloc_trim), so that the
+   * resident set read after a later step is what the process holds then.
+   */
   void
   SetupFloor::clear_system()
   {
     amg.clear();
     system_matrix.clear();
     system_rhs.clear();
+    malloc_trim(0);
   }
 
 
@@ -569,7 +596,8 @@ namespace setup_floor
     const auto   per_dof = [&](const double kib) {
       return static_cast<long>(std::round(kib * 1024 / n_dofs));
     };
-    std::cout << triangulation.n_global_active_cells() << " cells, "
+    std::cout << (full_coupling ? "full" : "components") << " coupling, "
+              << triangulation.n_global_active_cells() << " cells, "
               << dof_handler.n_dofs() << " DoFs, " << cg_iterations
               << " CG iterations\n\n"
               << "| step | s | peak MiB | peak B/DoF | current B/DoF |\n"
@@ -639,7 +667,12 @@ main(int argc, char *argv[])
     {
       dealii::Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv);
       const unsigned int refinements = (argc > 1) ? std::stoi(argv[1]) : 9;
-      setup_floor::SetupFloor(refinements).run();
+      const std::string  coupling    = (argc > 2) ? argv[2] : "components";
+      if (coupling != "components" && coupling != "full")
+        throw std::invalid_argument("the coupling is 'components' or 'full', "
+                                    "not '" +
+                                    coupling + "'");
+      setup_floor::SetupFloor(refinements, coupling == "full").run();
     }
   catch (const std::exception &exception)
     {

@@ -8,7 +8,9 @@
 # `cmake --build build --target setup_floor`) and /tmp/membranes-setup-floor.
 # RUNS=n in the environment sets the number of runs (default 3),
 # REFINEMENTS=k the refinements of the previous mesh (default 9: the
-# measured cycle goes from 512 × 512 to 1024 × 1024 cells). Each run's
+# measured cycle goes from 512 × 512 to 1024 × 1024 cells), COUPLING=full
+# the sparsity pattern of the coupled system instead of the mesh's
+# operator (COUPLING=components, the default). Each run's
 # tables are kept in <output-dir>/run<i>.md, the medians in medians.md.
 set -euo pipefail
 
@@ -27,7 +29,7 @@ rm -f "$out"/run*.md
 echo "== $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start"
 for ((run = 1; run <= runs; ++run)); do
   echo "== run $run"
-  nice "$program" "${REFINEMENTS:-9}" | tee "$out/run$run.md"
+  nice "$program" "${REFINEMENTS:-9}" "${COUPLING:-components}" | tee "$out/run$run.md"
 done
 echo "== load average $(cut -d' ' -f1-3 /proc/loadavg) at end"
 echo "== medians of $runs runs"
