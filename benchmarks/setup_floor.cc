@@ -231,7 +231,9 @@ namespace setup_floor
 
   /**
    * Run @p action, and record its wall time and the memory of the process
-   * afterwards as the step @p name.
+   * afterwards as the step @p name: the peak of the resident set so far,
+   * and the resident set once the memory freed in the step has gone back to
+   * the system (glibc's malloc_trim), that is, what the process holds.
    */
   template <typename Action>
   void
@@ -243,6 +245,7 @@ namespace setup_floor
     action();
     const std::chrono::duration<double> seconds =
       std::chrono::steady_clock::now() - start;
+    malloc_trim(0);
     Utilities::System::MemoryStats memory;
     Utilities::System::get_memory_stats(memory);
     steps.push_back({name,
@@ -568,18 +571,13 @@ namespace setup_floor
 
 
 
-  /**
-   * The linear system of a mesh is freed once the mesh is solved on; the
-   * memory goes back to the system (glibc's malloc_trim), so that the
-   * resident set read after a later step is what the process holds then.
-   */
+  /** The linear system of a mesh is freed once the mesh is solved on. */
   void
   SetupFloor::clear_system()
   {
     amg.clear();
     system_matrix.clear();
     system_rhs.clear();
-    malloc_trim(0);
   }
 
 
@@ -600,7 +598,7 @@ namespace setup_floor
               << triangulation.n_global_active_cells() << " cells, "
               << dof_handler.n_dofs() << " DoFs, " << cg_iterations
               << " CG iterations\n\n"
-              << "| step | s | peak MiB | peak B/DoF | current B/DoF |\n"
+              << "| step | s | peak MiB | peak B/DoF | held B/DoF |\n"
               << "|---|--:|--:|--:|--:|\n"
               << std::fixed;
     double setup = 0, solve = 0;
