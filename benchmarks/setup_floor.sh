@@ -10,7 +10,10 @@
 # REFINEMENTS=k the refinements of the previous mesh (default 9: the
 # measured cycle goes from 512 × 512 to 1024 × 1024 cells), COUPLING=full
 # the sparsity pattern of the coupled system instead of the mesh's
-# operator (COUPLING=components, the default). Each run's
+# operator (COUPLING=components, the default), TRIM=1 the memory freed in
+# each step given back to the system before the resident set is read (the
+# current resident set is then what the process holds; the times are
+# longer). Each run's
 # tables are kept in <output-dir>/run<i>.md, the medians in medians.md.
 set -euo pipefail
 
@@ -29,7 +32,8 @@ rm -f "$out"/run*.md
 echo "== $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start"
 for ((run = 1; run <= runs; ++run)); do
   echo "== run $run"
-  nice "$program" "${REFINEMENTS:-9}" "${COUPLING:-components}" | tee "$out/run$run.md"
+  nice "$program" "${REFINEMENTS:-9}" "${COUPLING:-components}" \
+    ${TRIM:+trim} | tee "$out/run$run.md"
 done
 echo "== load average $(cut -d' ' -f1-3 /proc/loadavg) at end"
 echo "== medians of $runs runs"
