@@ -17,13 +17,13 @@
  *
  * The mesh of case M (the square (-1,1)², global refinement) is refined
  * @p refinements times (default 9: 512 × 512 cells) and solved on, as the
- * previous cycle; the measured cycle is the next one (1024 × 1024 cells,
- * 2 101 250 DoFs). After each step the program reads the peak resident set
- * size (VmHWM) and the current one (VmRSS) of the process. With `trim`,
- * the memory freed in a step goes back to the system first (glibc's
- * malloc_trim), so that the current resident set is what the process
- * holds; the later steps then touch fresh pages instead of reusing freed
- * ones, which costs time, so the times are read without it.
+ * previous cycle; the measured cycle is the next one (1024 × 1024 cells).
+ * After each step the program reads the peak resident set size (VmHWM) and
+ * the current one (VmRSS) of the process. With `trim`, the memory freed in
+ * a step goes back to the system first (glibc's malloc_trim), so that the
+ * current resident set is what the process holds; the later steps then
+ * touch fresh pages instead of reusing freed ones, which costs time, so
+ * the times are read without it.
  *
  * The matrix couples the DoFs of a cell in the way of membranes'
  * MeshOperator, each component only with itself (`components`, the
