@@ -485,8 +485,6 @@ namespace membranes
     std::vector<CompiledFunctions::Request> requests;
     for (const auto &expression : scene)
       requests.push_back(expression.second);
-    // The error norms want u1, u2 with their gradients and λ at the same
-    // points: one group.
     // The loads at the same points: f1 and f2, or what the manufactured
     // loads are made of. The error norms want u1, u2 with their gradients
     // and λ at the same points.
