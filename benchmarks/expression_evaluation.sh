@@ -24,8 +24,8 @@
 # is muparser's (libmuparser), deal.II's muparser callbacks, the compiled
 # expressions (expressions-*.so), ProblemData's evaluation (Expression,
 # its thread-local parsers, the lists of loads and of the exact solution
-# with their checks), or libm (sin, cos, exp, pow: the program calls
-# them from nowhere else in the hot loops). Also printed: the whole-process
+# with their checks), or libm and its vector forms libmvec (sin, cos,
+# exp, pow: the program calls them from nowhere else in the hot loops). Also printed: the whole-process
 # wall time, and the time of the first run of the compiled scene against a
 # second one (compiling against the cache) with an empty cache directory.
 # Needs perf (apt-get install linux-perf). CYCLES=n shortens the runs.
@@ -54,7 +54,7 @@ share() {
     2> /dev/null |
     awk '/^ +[0-9.]+%/ {
            p = $1; sub("%", "", p);
-           if ($0 ~ /libmuparser|expressions-[0-9a-f]+\.so|libm\.so|ProblemData<2>::|ExpressionEntry<2>|ThreadParsers|FunctionParser::mu_/)
+           if ($0 ~ /libmuparser|expressions-[0-9a-f]+\.so|libm\.so|libmvec\.so|ProblemData<2>::|ExpressionEntry<2>|ThreadParsers|FunctionParser::mu_/)
              s += p
          }
          END { printf "%.1f", s }'

@@ -16,6 +16,24 @@ namespace membranes
      * arguments to the nearest integer; `?:`, `&&`, `||` test against 0).
      */
     const char *const prelude = R"(#include <cmath>
+// The vector forms of sin, cos, exp, log and pow in glibc's libmvec (x86-64),
+// declared for GCC: a loop over points that it vectorizes then calls them,
+// two to eight points at once (_ZGVdN4v_cos: four, with AVX2). The program
+// compiles sin and cos as plain functions (-fno-builtin-sin and -cos), else
+// GCC would merge the sin(x) and cos(x) of a dual number into one sincos,
+// which has no vector form it calls.
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && \
+  !defined(__clang__)
+#define MEMBRANES_VECTOR_FORM __attribute__((simd("notinbranch"), const))
+extern "C"
+{
+  MEMBRANES_VECTOR_FORM double sin(double) noexcept;
+  MEMBRANES_VECTOR_FORM double cos(double) noexcept;
+  MEMBRANES_VECTOR_FORM double exp(double) noexcept;
+  MEMBRANES_VECTOR_FORM double log(double) noexcept;
+  MEMBRANES_VECTOR_FORM double pow(double, double) noexcept;
+}
+#endif
 // Every function of the prelude is small: inlined into the expression, so
 // that a dual number's components stay in registers.
 #define MEMBRANES_INLINE inline __attribute__((always_inline))
@@ -131,7 +149,7 @@ namespace
   MEMBRANES_UNARY(erfc, -1.12837916709551257390 * exp(-x * x))
 #undef MEMBRANES_UNARY
 
-  template <class T> Dual<T> atan2(const Dual<T> &a, const Dual<T> &b)
+  template <class T> MEMBRANES_INLINE Dual<T> atan2(const Dual<T> &a, const Dual<T> &b)
   {
     Dual<T> r;
     r.v = atan2(a.v, b.v);
@@ -140,7 +158,7 @@ namespace
       r.d[i] = (b.v * a.d[i] - a.v * b.d[i]) / s;
     return r;
   }
-  template <class T> Dual<T> pow(const Dual<T> &a, const Dual<T> &b)
+  template <class T> MEMBRANES_INLINE Dual<T> pow(const Dual<T> &a, const Dual<T> &b)
   {
     Dual<T> r;
     r.v = pow(a.v, b.v);
@@ -239,35 +257,80 @@ namespace
 )";
 
     /**
-     * The body of group @p group's loop over the points, at the point p:
-     * each member evaluated in the number type its derivatives need, and
-     * written to out.
+     * The evaluation of group @p group at the point p: each member in the
+     * number type its derivatives need, written to out, one value after the
+     * other. The coordinates of p are read once into x (a local copy that
+     * a vectorized loop reads whole, whichever branch of a conditional it
+     * takes), and seeded as dual numbers once for all members (first
+     * derivatives in v1, second ones in v2).
      */
     std::string
     group_member_lines(const CompiledFunctions::Group &group)
     {
+      bool first = false, second = false;
+      for (const CompiledFunctions::Member &member : group.members)
+        {
+          first  = first || (member.gradient && !member.laplacian);
+          second = second || member.laplacian;
+        }
       std::ostringstream out;
-      for (const CompiledFunctions::Member &member : group)
+      out << "    double x[n];\n    for (int d = 0; d < n; ++d) x[d] = p[d];\n";
+      if (first)
+        out << "    Dual<double> v1[n];\n    seed(x, v1);\n";
+      if (second)
+        out << "    Dual<Dual<double>> v2[n];\n    seed(x, v2);\n";
+      for (const CompiledFunctions::Member &member : group.members)
         {
           const std::string e =
             "expression_" + std::to_string(member.expression);
           if (member.laplacian)
-            out << "    {\n      Dual<Dual<double>> v[n];\n      seed(p, v);\n"
-                << "      const Dual<Dual<double>> r = " << e << "(v);\n"
-                << "      *out++ = r.v.v;\n"
+            out << "    {\n      const Dual<Dual<double>> r = " << e
+                << "(v2);\n      *out++ = r.v.v;\n"
                 << (member.gradient ?
                       "      for (int d = 0; d < n; ++d) *out++ = r.v.d[d];\n" :
                       "")
                 << "      *out++ = laplacian(r);\n    }\n";
           else if (member.gradient)
             out
-              << "    {\n      Dual<double> v[n];\n      seed(p, v);\n"
-              << "      const Dual<double> r = " << e << "(v);\n"
-              << "      *out++ = r.v;\n"
+              << "    {\n      const Dual<double> r = " << e
+              << "(v1);\n      *out++ = r.v;\n"
               << "      for (int d = 0; d < n; ++d) *out++ = r.d[d];\n    }\n";
           else
-            out << "    *out++ = " << e << "(p);\n";
+            out << "    *out++ = " << e << "(x);\n";
         }
+      return out.str();
+    }
+
+
+
+    /**
+     * Group @p g as the function membranes_group_g: a loop over the points.
+     * With vector math the members are inlined into the body of the loop,
+     * which the compiler may then vectorize; without, the body is a function
+     * of its own, called once per point, so that every point is evaluated
+     * alone with the scalar functions.
+     */
+    std::string
+    group_function(const CompiledFunctions::Group &group, const unsigned int g)
+    {
+      const std::string  s = std::to_string(g);
+      std::ostringstream out;
+      if (group.vector_math)
+        out << "extern \"C\" void membranes_group_" << s
+            << "(const double *__restrict points, const unsigned int "
+               "n_points, double *__restrict out) {\n"
+            << "  for (unsigned int q = 0; q < n_points; ++q) {\n"
+            << "    const double *p = points + n * q;\n"
+            << group_member_lines(group) << "  }\n}\n";
+      else
+        out << "static __attribute__((noinline)) double *group_point_" << s
+            << "(const double *p, double *out) {\n"
+            << group_member_lines(group) << "  return out;\n}\n"
+            << "extern \"C\" void membranes_group_" << s
+            << "(const double *points, const unsigned int n_points, "
+               "double *out) {\n"
+            << "  for (unsigned int q = 0; q < n_points; ++q)\n"
+            << "    out = group_point_" << s << "(points + n * q, out);\n}\n";
       return out.str();
     }
 
@@ -308,15 +371,10 @@ namespace
               << "  Dual<Dual<double>> v[n];\n  seed(p, v);\n"
               << "  return laplacian(" << e << "(v));\n}\n";
       }
-    // One loop per group over its points: the members are inlined into
-    // the same body, where the compiler computes what they share once.
+    // One loop per group over its points: the members are evaluated in the
+    // same body, where the compiler computes what they share once.
     for (unsigned int g = 0; g < groups.size(); ++g)
-      out << "extern \"C\" void membranes_group_" << g
-          << "(const double *points, const unsigned int n_points, "
-             "double *out) {\n"
-          << "  for (unsigned int q = 0; q < n_points; ++q) {\n"
-          << "    const double *p = points + n * q;\n"
-          << group_member_lines(groups[g]) << "  }\n}\n";
+      out << group_function(groups[g], g);
     return out.str();
   }
 } // namespace membranes

@@ -487,19 +487,22 @@ namespace membranes
       requests.push_back(expression.second);
     // The loads at the same points: f1 and f2, or what the manufactured
     // loads are made of. The error norms want u1, u2 with their gradients
-    // and λ at the same points.
+    // and λ at the same points. The loads decide the discrete solution:
+    // evaluated point by point, as the parser does; the exact solution only
+    // enters the error norms: with vector math.
     std::vector<CompiledFunctions::Group> groups;
     if (manufactured)
-      groups.push_back({{position(scene, exact_u[0].get()), false, true},
-                        {position(scene, exact_u[1].get()), false, true},
-                        {position(scene, exact_action.get())}});
+      groups.push_back({{{position(scene, exact_u[0].get()), false, true},
+                         {position(scene, exact_u[1].get()), false, true},
+                         {position(scene, exact_action.get())}}});
     else
       groups.push_back(
-        {{position(scene, f[0].get())}, {position(scene, f[1].get())}});
+        {{{position(scene, f[0].get())}, {position(scene, f[1].get())}}});
     if (known)
-      groups.push_back({{position(scene, exact_u[0].get()), true},
-                        {position(scene, exact_u[1].get()), true},
-                        {position(scene, exact_action.get())}});
+      groups.push_back({{{position(scene, exact_u[0].get()), true},
+                         {position(scene, exact_u[1].get()), true},
+                         {position(scene, exact_action.get())}},
+                        true});
     compiled    = std::make_unique<CompiledFunctions>(requests,
                                                    variable_names<dim>(),
                                                    all_constants,
