@@ -8,6 +8,7 @@
 // of each expression: the same numbers, in the group's order, bit for bit;
 // to 1e-14 with vector math.
 
+#include <cstdlib>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
 #include <iostream>
@@ -95,8 +96,9 @@ namespace
               << std::endl;
 #if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && \
   !defined(__clang__)
-    // Where GCC and libmvec are, the loop of group 1 calls the vector forms.
-    if (n_different == 0)
+    // Where GCC (the compiler of this test, unless MEMBRANES_CXX names
+    // another) and libmvec are, the loop of group 1 calls the vector forms.
+    if (n_different == 0 && std::getenv("MEMBRANES_CXX") == nullptr)
       {
         ++failures;
         std::cout << "FAIL group 1 equals the scalar functions bit for bit: "
