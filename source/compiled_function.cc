@@ -39,10 +39,9 @@ namespace membranes
      * plain functions: see the prelude of the generated source. No
      * reordering and no contraction into fused multiply-adds
      * (-ffp-contract=off): every operation is rounded as the parser rounds
-     * it. AVX2 and FMA, four
-     * points at once, where the processor has them: they are then part of
-     * the cache key, so that a cache shared between machines holds one
-     * object for each kind.
+     * it. AVX2 and FMA (four points at once) where the processor has
+     * them: they are then part of the cache key, so that a cache shared
+     * between machines holds one object for each kind.
      */
     std::vector<std::string>
     compiler_flags()

@@ -69,14 +69,15 @@ namespace
             {
               const std::string &expression = expressions[member.expression];
               const auto same = [&](const std::string &what, const double b) {
-                const double a = *group_value++;
-                n_different += (g == 1 && a != b);
+                const double a           = *group_value++;
+                const bool   vector_math = groups[g].vector_math;
+                n_different += (vector_math && a != b);
                 compare("group " + std::to_string(g) + " " + what,
                         expression,
                         p,
                         a,
                         b,
-                        g == 0 ? 0. : 1e-14 * std::max(1., std::abs(b)));
+                        vector_math ? 1e-14 * std::max(1., std::abs(b)) : 0.);
               };
               same("value", compiled.value(member.expression)(&p[0]));
               if (member.gradient)
