@@ -368,6 +368,29 @@ namespace
 
 
 
+  /**
+   * d_a, ∫|∇φ_a|² (as MeshOperator sums it) and c_a at the vertex @p a of
+   * @p problem against the hand values. A scaled or unlumped mass moves
+   * d_a; a wrong stiffness diagonal ∫|∇φ_a|²; μ1 or μ2 in place of μ̄, or
+   * a wrong d_a, moves c_a = μ̄ ∫|∇φ_a|² / d_a.
+   */
+  void
+  check_vertex_data(const TinyProblem               &problem,
+                    const MeshOperator<dim>::Vertex &a,
+                    const std::string               &name,
+                    const double                     d_a,
+                    const double                     stiffness,
+                    const double                     c_a)
+  {
+    check(name + ": d_a = int phi_a", a.dual_cell_measure, d_a);
+    check(name + ": int |grad phi_a|^2", a.stiffness_diagonal, stiffness);
+    check(name + ": c_a = mu_bar int|grad phi_a|^2 / d_a",
+          problem.active_set.contact_stiffness(a),
+          c_a);
+  }
+
+
+
   /** Mesh 1: 2×2 squares. */
   void
   two_by_two()
@@ -386,14 +409,8 @@ namespace
     const unsigned int k = problem.vertex_at(Point<dim>(0.5, 0.5));
     const auto        &a = vertices[k];
 
-    // d_a = h² = 1/4: a scaled or unlumped mass (e.g. the diagonal h²/9·4).
-    check("Q1 2x2: d_a = int phi_a", a.dual_cell_measure, 1. / 4.);
-    // ∫|∇φ_a|² = 4 · 2/3: a wrong stiffness diagonal.
-    check("Q1 2x2: int |grad phi_a|^2", a.stiffness_diagonal, 8. / 3.);
-    // c_a = μ̄ (8/3)/(1/4) = 64/9: μ1 or μ2 in place of μ̄, or d_a squared.
-    check("Q1 2x2: c_a = mu_bar int|grad phi_a|^2 / d_a",
-          problem.active_set.contact_stiffness(a),
-          64. / 9.);
+    // d_a = h² = 1/4, ∫|∇φ_a|² = 4 · 2/3, c_a = μ̄ (8/3)/(1/4) = 64/9.
+    check_vertex_data(problem, a, "Q1 2x2", 1. / 4., 8. / 3., 64. / 9.);
 
     // The weights of lambda() on the zero iterate, where the two formulas
     // of (4.5) differ (λ_1a = 2, λ_2a = 1): swapped weights give 4/3.
@@ -467,23 +484,14 @@ namespace
     const auto        &a  = vertices[ka];
     const auto        &b  = vertices[kb];
 
-    // d_a = 15/64 with the shares ½ ∫ φ_c of the hanging vertices; without
-    // condensation it would be 13/64.
-    check("Q1 hanging: d_a = int phi_a (condensed)",
-          a.dual_cell_measure,
-          15. / 64.);
+    // d_a = 15/64 with the shares ½ ∫ φ_c of the hanging vertices (without
+    // condensation it would be 13/64); ∫|∇φ_a|² as Σ_K A_K(a,a), uncondensed
+    // as documented: 4 · 2/3.
+    check_vertex_data(
+      problem, a, "Q1 hanging, vertex a", 15. / 64., 8. / 3., 1024. / 135.);
     // d_b = 4 (1/4)²/4 = 1/16: the fine cells' measure.
-    check("Q1 hanging: d_b", b.dual_cell_measure, 1. / 16.);
-    // Σ_K A_K(a,a), uncondensed as documented: 4 · 2/3.
-    check("Q1 hanging: sum_K A_K(a,a)", a.stiffness_diagonal, 8. / 3.);
-    check("Q1 hanging: sum_K A_K(b,b)", b.stiffness_diagonal, 8. / 3.);
-    // c_a, c_b: μ̄ and d_a of the hanging-node mesh.
-    check("Q1 hanging: c_a",
-          problem.active_set.contact_stiffness(a),
-          1024. / 135.);
-    check("Q1 hanging: c_b",
-          problem.active_set.contact_stiffness(b),
-          256. / 9.);
+    check_vertex_data(
+      problem, b, "Q1 hanging, vertex b", 1. / 16., 8. / 3., 256. / 9.);
 
     problem.solve();
     check_contact_vertex(problem, ka, "Q1 hanging, vertex a", -1. / 32.);
@@ -529,12 +537,9 @@ namespace
     const unsigned int k = problem.vertex_at(Point<dim>(0.5, 0.5));
     const auto        &a = vertices[k];
 
-    // d_a = Σ_K meas(K)/3 = 1/3: a scaled lumped mass.
-    check("P1 4 triangles: d_a = int phi_a", a.dual_cell_measure, 1. / 3.);
-    // ∫|∇φ_a|² = 4 triangles · area 1/4 · |∇φ_a|² = 4.
-    check("P1 4 triangles: int |grad phi_a|^2", a.stiffness_diagonal, 4.);
-    // c_a = μ̄ · 4/(1/3) = 8.
-    check("P1 4 triangles: c_a", problem.active_set.contact_stiffness(a), 8.);
+    // d_a = Σ_K meas(K)/3 = 1/3, ∫|∇φ_a|² = 4 triangles · area 1/4 ·
+    // |∇φ_a|² = 4, c_a = μ̄ · 4/(1/3) = 8.
+    check_vertex_data(problem, a, "P1 4 triangles", 1. / 3., 4., 8.);
 
     problem.solve();
     check_contact_vertex(problem, k, "P1 4 triangles, contact", -1. / 36.);
