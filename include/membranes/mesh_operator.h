@@ -54,7 +54,11 @@ namespace membranes
       std::array<types::global_dof_index, 2> dof;
       /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
       double dual_cell_measure;
-      /** ∫ |∇φ_a|², the scale of the stiffness matrix at a. */
+      /**
+       * Σ_K A_K(a, a) = ∫ |∇φ_a|² for the hat function of a without the
+       * shares of the hanging vertices it constrains (laplace_diagonal()):
+       * the scale of the stiffness matrix at a.
+       */
       double stiffness_diagonal;
       /**
        * Σ_b |A_ab|, the l1 norm of the row of a in the Laplacian A
