@@ -188,7 +188,7 @@ def fields_figure(membranes, out):
     figure, axes = plt.subplots(1, 4, figsize=(21, 4.8))
     for axis, name, title in ((axes[0], "u1", "$u_{1h}$"),
                               (axes[1], "u2", "$u_{2h}$"),
-                              (axes[2], "u1_minus_u2", "$u_{1h}-u_{2h}$"),
+                              (axes[2], "w", "$u_{1h}-u_{2h}$"),
                               (axes[3], "lambda_h", r"$\lambda_a$ and the active set")):
         plot = axis.tripcolor(mesh, vtu[name], shading="gouraud",
                               cmap="viridis")

@@ -161,36 +161,36 @@ namespace membranes
     : parameters(parameters)
     , data(data)
     , history(mpi_communicator)
-    , prediction(discretization, data)
+    , predicted_action(discretization, data)
   {}
 
 
 
   template <int dim>
   void
-  ActiveSet<dim>::reinit(const MeshOperator<dim> &mesh_operator)
+  ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
   {
-    mesh            = &mesh_operator;
-    active_vertices = IndexSet(mesh_operator.get_dof_handler().n_dofs());
-    prediction.reinit(mesh_operator);
+    problem         = &discrete_problem;
+    active_vertices = IndexSet(discrete_problem.locally_owned_dofs().size());
+    predicted_action.reinit(discrete_problem);
   }
 
 
 
   template <int dim>
   void
-  ActiveSet<dim>::reinit(const MeshOperator<dim> &mesh_operator,
-                         const VectorType        &ghosted_solution,
-                         const VectorType        &ghosted_lambda_h)
+  ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem,
+                         const VectorType           &ghosted_solution,
+                         const VectorType           &ghosted_lambda_h)
   {
-    reinit(mesh_operator);
+    reinit(discrete_problem);
     const double epsilon = parameters.tolerance;
     const double u_scale = displacement_scale(ghosted_solution);
-    for (const auto &a : mesh->vertices())
+    for (const auto &a : problem->vertices())
       {
         const double c      = contact_stiffness(a);
         const double lambda = ghosted_lambda_h[a.dof[0]] / (c * u_scale);
-        const double w      = gap(a, ghosted_solution) / u_scale;
+        const double w      = nodal_w(a, ghosted_solution) / u_scale;
         const bool   degenerate =
           std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
         if (!degenerate && lambda - w > 0)
@@ -224,7 +224,7 @@ namespace membranes
   ActiveSet<dim>::n_active_vertices() const
   {
     return Utilities::MPI::sum(active_vertices.n_elements(),
-                               mesh->get_mpi_communicator());
+                               problem->get_mpi_communicator());
   }
 
 
@@ -233,18 +233,18 @@ namespace membranes
   IndexSet
   ActiveSet<dim>::locally_relevant() const
   {
-    const MPI_Comm mpi_communicator = mesh->get_mpi_communicator();
-    VectorType     owned_flags(mesh->locally_owned_dofs(), mpi_communicator);
+    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
+    VectorType     owned_flags(problem->locally_owned_dofs(), mpi_communicator);
     for (const auto dof : active_vertices)
       owned_flags[dof] = 1;
     owned_flags.compress(VectorOperation::insert);
-    VectorType flags(mesh->locally_owned_dofs(),
-                     mesh->locally_relevant_dofs(),
+    VectorType flags(problem->locally_owned_dofs(),
+                     problem->locally_relevant_dofs(),
                      mpi_communicator);
     flags = owned_flags;
 
     IndexSet relevant_active_set(active_vertices.size());
-    for (const auto &dofs : mesh->locally_relevant_vertices())
+    for (const auto &dofs : problem->locally_relevant_vertices())
       if (flags[dofs[0]] > 0)
         relevant_active_set.add_index(dofs[0]);
     relevant_active_set.compress();
@@ -254,8 +254,29 @@ namespace membranes
 
 
   template <int dim>
+  typename ActiveSet<dim>::VectorType
+  ActiveSet<dim>::lambda_and_flags(const VectorType &lambda_h) const
+  {
+    VectorType fields(problem->locally_owned_dofs(),
+                      problem->get_mpi_communicator());
+    for (const auto &a : problem->vertices())
+      {
+        fields[a.dof[0]] = lambda_h[a.dof[0]];
+        fields[a.dof[1]] = is_element(a.dof[0]) ? 1 : 0;
+      }
+    fields.compress(VectorOperation::insert);
+    VectorType ghosted_fields(problem->locally_owned_dofs(),
+                              problem->locally_relevant_dofs(),
+                              problem->get_mpi_communicator());
+    ghosted_fields = fields;
+    return ghosted_fields;
+  }
+
+
+
+  template <int dim>
   double
-  ActiveSet<dim>::gap(const Vertex &a, const VectorType &solution)
+  ActiveSet<dim>::nodal_w(const Vertex &a, const VectorType &solution)
   {
     return solution[a.dof[0]] - solution[a.dof[1]];
   }
@@ -278,12 +299,12 @@ namespace membranes
   {
     const double max = std::numeric_limits<double>::max();
     KKTDefects   defects{0, 0, max, max, max, 0};
-    const auto  &vertices = mesh->vertices();
+    const auto  &vertices = problem->vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a             = vertices[k];
         const double d             = a.dual_cell_measure;
-        const double w             = gap(a, solution);
+        const double w             = nodal_w(a, solution);
         const double lambda        = action.lambda(k);
         const double contact_force = lambda * d;
         defects.sum_equilibrium =
@@ -301,7 +322,7 @@ namespace membranes
         defects.complementarity =
           std::max(defects.complementarity, std::abs(contact_force * w));
       }
-    const MPI_Comm mpi_communicator = mesh->get_mpi_communicator();
+    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
     for (double *maximum : {&defects.sum_equilibrium,
                             &defects.contact_equilibrium,
                             &defects.complementarity})
@@ -323,14 +344,14 @@ namespace membranes
     const double u_scale = displacement_scale(solution);
 
     std::vector<StatusChange> changes;
-    const auto               &vertices = mesh->vertices();
+    const auto               &vertices = problem->vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a = vertices[k];
         const double violation =
           is_element(a.dof[0]) ?
             -action.lambda(k) / (contact_stiffness(a) * u_scale) :
-            -gap(a, solution) / u_scale;
+            -nodal_w(a, solution) / u_scale;
         if (violation > epsilon)
           changes.push_back({a.dof[0], violation / epsilon});
       }
@@ -360,9 +381,10 @@ namespace membranes
       {
         predicted                     = predicted_changes(solution, changes);
         update.predicted_force_scales = {
-          {prediction.force_scale(), prediction.contact_force_scale()}};
+          {predicted_action.force_scale(),
+           predicted_action.contact_force_scale()}};
         if (Utilities::MPI::sum(predicted.size(),
-                                mesh->get_mpi_communicator()) > 0)
+                                problem->get_mpi_communicator()) > 0)
           next = &predicted;
       }
     static_cast<ActiveSetHistory::Step &>(update) =
@@ -382,8 +404,8 @@ namespace membranes
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     const double epsilon   = parameters.tolerance;
     const double u_scale   = displacement_scale(solution);
-    const auto  &vertices  = mesh->vertices();
-    const auto  &positions = mesh->local_positions();
+    const auto  &vertices  = problem->vertices();
+    const auto  &positions = problem->local_positions();
 
     // Projected Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
@@ -396,12 +418,12 @@ namespace membranes
     double *const values  = iterate.begin();
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
-        prediction.compute(iterate);
+        predicted_action.compute(iterate);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
             const auto  &a = vertices[k];
             const double w = values[positions[k][0]] - values[positions[k][1]];
-            const double r = prediction.lambda(k) * a.dual_cell_measure;
+            const double r = predicted_action.lambda(k) * a.dual_cell_measure;
             const double step =
               std::max(0.,
                        w - 2 * r / (data.mu_bar * a.stiffness_row_l1_norm)) -
@@ -410,7 +432,7 @@ namespace membranes
             values[positions[k][1]] -= mu1 / M * step;
           }
       }
-    prediction.compute(iterate);
+    predicted_action.compute(iterate);
 
     // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
     // indifference; the plain test where the predicted one is in the band.
@@ -420,7 +442,8 @@ namespace membranes
         const auto  &a = vertices[k];
         const double c = contact_stiffness(a);
         const double test =
-          (prediction.lambda(k) - c * gap(a, iterate)) / (c * u_scale);
+          (predicted_action.lambda(k) - c * nodal_w(a, iterate)) /
+          (c * u_scale);
         const double violation = is_element(a.dof[0]) ? -test : test;
         if (violation > epsilon)
           changes.push_back({a.dof[0], violation / epsilon});

@@ -2,6 +2,7 @@
 #include <array>
 #include <cmath>
 #include <deal.II/base/mpi.h>
+#include <deal.II/grid/grid_tools.h>
 #include <iomanip>
 #include <limits>
 #include <membranes/active_set_solver.h>
@@ -29,21 +30,24 @@ namespace membranes
      * is the decoupled one, faster on every scene measured
      * (benchmarks/solver_cost.sh): its systems are half the size of the
      * coupled one, S is solved once per mesh, and its operators are taken
-     * from the mesh's operator (MeshOperator) without a new assembly.
+     * from the mesh's matrix (DiscreteProblem) without a new assembly.
      */
     template <int dim>
     std::unique_ptr<ActiveSetSystem<dim>>
     make_active_set_system(const Parameters::Solver  &parameters,
                            const Discretization<dim> &discretization,
                            const ProblemData<dim>    &data,
-                           TimerOutput               &timer,
                            const MPI_Comm             mpi_communicator)
     {
       if (parameters.method == Parameters::SolverMethod::coupled)
-        return std::make_unique<CoupledSystem<dim>>(
-          parameters, discretization, data, timer, mpi_communicator);
-      return std::make_unique<DecoupledSystem<dim>>(
-        parameters, discretization, data, timer, mpi_communicator);
+        return std::make_unique<CoupledSystem<dim>>(parameters,
+                                                    discretization,
+                                                    data,
+                                                    mpi_communicator);
+      return std::make_unique<DecoupledSystem<dim>>(parameters,
+                                                    discretization,
+                                                    data,
+                                                    mpi_communicator);
     }
   } // namespace
 
@@ -65,45 +69,48 @@ namespace membranes
     , system(make_active_set_system(parameters,
                                     discretization,
                                     data,
-                                    timer,
                                     mpi_communicator))
   {}
 
 
 
   template <int dim>
+  ActiveSetSolver<dim>::~ActiveSetSolver() = default;
+
+
+
+  template <int dim>
   void
-  ActiveSetSolver<dim>::setup(const MeshOperator<dim> &mesh_operator)
+  ActiveSetSolver<dim>::setup(
+    const DiscreteProblem<dim>      &discrete_problem,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const DoFHandler<dim>           &scalar_dof_handler)
   {
-    mesh = &mesh_operator;
-    system->setup(mesh_operator);
+    problem = &discrete_problem;
+    system->setup(discrete_problem,
+                  dof_handler,
+                  hanging_node_constraints,
+                  scalar_dof_handler);
 
     // The constants of balanced stopping: C_F of the bounding box of the
     // mesh, c_M of the lumped mass, and d_min.
-    std::array<double, dim> lower, upper;
-    lower.fill(std::numeric_limits<double>::max());
-    upper.fill(-std::numeric_limits<double>::max());
-    const auto &dof_handler   = mesh_operator.get_dof_handler();
-    const auto &triangulation = dof_handler.get_triangulation();
-    for (unsigned int v = 0; v < triangulation.n_vertices(); ++v)
-      if (triangulation.get_used_vertices()[v])
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            lower[d] = std::min(lower[d], triangulation.get_vertices()[v][d]);
-            upper[d] = std::max(upper[d], triangulation.get_vertices()[v][d]);
-          }
+    const BoundingBox<dim> box =
+      GridTools::compute_bounding_box(dof_handler.get_triangulation());
     double inverse_squares = 0;
     for (unsigned int d = 0; d < dim; ++d)
       inverse_squares +=
-        std::pow(Utilities::MPI::max(upper[d], mpi_communicator) -
-                   Utilities::MPI::min(lower[d], mpi_communicator),
+        std::pow(Utilities::MPI::max(box.get_boundary_points().second[d],
+                                     mpi_communicator) -
+                   Utilities::MPI::min(box.get_boundary_points().first[d],
+                                       mpi_communicator),
                  -2);
     const double lumped_mass_constant =
       dof_handler.get_fe().reference_cell().is_simplex() ? 2 : 3;
     dual_norm_constant =
       lumped_mass_constant / (numbers::PI * std::sqrt(inverse_squares));
     double min_measure = std::numeric_limits<double>::max();
-    for (const auto &a : mesh_operator.vertices())
+    for (const auto &a : discrete_problem.vertices())
       min_measure = std::min(min_measure, a.dual_cell_measure);
     min_dual_cell_measure = Utilities::MPI::min(min_measure, mpi_communicator);
   }
@@ -112,7 +119,7 @@ namespace membranes
 
   template <int dim>
   LinearTolerances
-  ActiveSetSolver<dim>::linear_tolerances(const Stopping &stopping) const
+  ActiveSetSolver<dim>::linear_tolerances(const StoppingState &stopping) const
   {
     const double     allowed = parameters.tolerance / stopping.tightening;
     LinearTolerances tolerances{allowed * stopping.force_scales[0],
@@ -135,7 +142,7 @@ namespace membranes
   ActiveSetSolver<dim>::evaluate(const DiscreteAction<dim> &action,
                                  const VectorType          &solution,
                                  const ActiveSet<dim>      &active_set,
-                                 const Stopping            &stopping,
+                                 const StoppingState       &stopping,
                                  Statistics                &statistics) const
   {
     const double tiny = std::numeric_limits<double>::min();
@@ -158,7 +165,7 @@ namespace membranes
   bool
   ActiveSetSolver<dim>::stops(const Statistics             &statistics,
                               const types::global_dof_index n_changes,
-                              Stopping                     &stopping) const
+                              StoppingState                &stopping) const
   {
     if (stopping.balanced &&
         (n_changes == 0 ||
@@ -205,8 +212,8 @@ namespace membranes
   ActiveSetSolver<dim>::print_iteration(const Statistics     &statistics,
                                         const ActiveSet<dim> &active_set,
                                         const types::global_dof_index n_changes,
-                                        const unsigned int linear_iterations,
-                                        const Stopping    &stopping) const
+                                        const unsigned int   linear_iterations,
+                                        const StoppingState &stopping) const
   {
     pcout << "      active set iteration " << statistics.iterations << ": "
           << active_set.n_active_vertices() << " active vertices, " << n_changes
@@ -224,7 +231,7 @@ namespace membranes
 
 
   template <int dim>
-  typename ActiveSetSolver<dim>::Stopping
+  typename ActiveSetSolver<dim>::StoppingState
   ActiveSetSolver<dim>::start(const double expected_error) const
   {
     return {parameters.stopping == Parameters::Stopping::balanced &&
@@ -242,9 +249,8 @@ namespace membranes
   ActiveSetSolver<dim>::compute_action(DiscreteAction<dim> &action,
                                        const VectorType    &solution,
                                        VectorType          &ghosted_solution,
-                                       Stopping            &stopping) const
+                                       StoppingState       &stopping) const
   {
-    TimerOutput::Scope scope(timer, "solve");
     ghosted_solution = solution;
     action.compute(solution);
     stopping.force_scales = {
@@ -259,7 +265,7 @@ namespace membranes
                                const VectorType                &solution,
                                const std::vector<StatusChange> &changes,
                                const unsigned int               iteration,
-                               Stopping                        &stopping) const
+                               StoppingState                   &stopping) const
   {
     const auto update = active_set.update(solution, changes);
     if (update.cycle_to)
@@ -309,10 +315,11 @@ namespace membranes
       {
         const auto  &a    = vertices[k];
         const double norm = a.stiffness_row_l1_norm;
-        const double step = active_set.is_element(a.dof[0]) ?
-                              2 * std::max(-action.lambda(k), 0.) *
-                                a.dual_cell_measure / (data.mu_bar * norm) :
-                              std::max(-ActiveSet<dim>::gap(a, solution), 0.);
+        const double step =
+          active_set.is_element(a.dof[0]) ?
+            2 * std::max(-action.lambda(k), 0.) * a.dual_cell_measure /
+              (data.mu_bar * norm) :
+            std::max(-ActiveSet<dim>::nodal_w(a, solution), 0.);
         energy += data.mu_bar * norm * step * step;
       }
     return std::sqrt(Utilities::MPI::sum(energy, mpi_communicator));
@@ -348,23 +355,27 @@ namespace membranes
                               ActiveSet<dim>      &active_set,
                               const double         expected_error)
   {
-    Statistics statistics;
-    Stopping   stopping = start(expected_error);
-    VectorType ghosted_solution(mesh->locally_owned_dofs(),
-                                mesh->locally_relevant_dofs(),
+    Statistics    statistics;
+    StoppingState stopping = start(expected_error);
+    VectorType    ghosted_solution(problem->locally_owned_dofs(),
+                                problem->locally_relevant_dofs(),
                                 mpi_communicator);
-    compute_action(action, solution, ghosted_solution, stopping);
     active_set.restart();
     for (statistics.iterations = 1;; ++statistics.iterations)
       {
         const unsigned int linear_iterations = statistics.linear_iterations;
-        system->solve(active_set.locally_relevant(),
-                      solution,
-                      linear_tolerances(stopping),
-                      statistics);
-        compute_action(action, solution, ghosted_solution, stopping);
+        {
+          TimerOutput::Scope scope(timer, "assembly");
+          system->assemble(active_set.locally_relevant(), solution);
+        }
         TimerOutput::Scope scope(timer, "solve");
-        const auto         changes =
+        // The forces of the initial guess set the tolerances of the first
+        // linear solve.
+        if (statistics.iterations == 1)
+          compute_action(action, solution, ghosted_solution, stopping);
+        system->solve(solution, linear_tolerances(stopping), statistics);
+        compute_action(action, solution, ghosted_solution, stopping);
+        const auto changes =
           active_set.wanted_changes(action, ghosted_solution);
         const auto n_changes =
           Utilities::MPI::sum<types::global_dof_index>(changes.size(),

@@ -11,7 +11,7 @@ namespace membranes
     : discretization(discretization)
     , data(data)
     , dual_cell_quadrature(discretization.fe->reference_cell(), 2)
-    , lambda_h_vector(nullptr)
+    , problem(nullptr)
     , max_force(0)
     , max_contact_force(0)
   {}
@@ -20,11 +20,15 @@ namespace membranes
 
   template <int dim>
   void
-  DiscreteAction<dim>::reinit(const MeshOperator<dim> &mesh_operator)
+  DiscreteAction<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
   {
-    mesh = &mesh_operator;
-    stiffness_product.reinit(mesh_operator.locally_owned_dofs(),
-                             mesh_operator.get_mpi_communicator());
+    problem = &discrete_problem;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        membrane_values[i].reinit(discrete_problem.locally_owned_scalar_dofs(),
+                                  discrete_problem.get_mpi_communicator());
+        stiffness_products[i].reinit(membrane_values[i]);
+      }
   }
 
 
@@ -33,11 +37,22 @@ namespace membranes
   void
   DiscreteAction<dim>::compute(const VectorType &solution)
   {
-    // The two terms of (4.5) at every DoF: μ_i ∫ ∇u_ih·∇φ as the product of
-    // the operator with the nodal values (those of hanging nodes follow
-    // from their parents, whose columns hold the condensed couplings), and
-    // the loads ∫ f_i φ of this mesh.
-    mesh->stiffness_matrix().vmult(stiffness_product, solution);
+    // The two terms of (4.5) at every vertex: μ_i ∫ ∇u_ih·∇φ as μ_i times
+    // the product of A with the nodal values U_i of membrane i (those of
+    // hanging nodes follow from their parents, whose columns hold the
+    // condensed couplings; those on ∂ω enter through the lifted loads, see
+    // stiffness_term()), and the loads ∫ f_i φ of this mesh. The FESystem
+    // stores U1 and U2 of a vertex one after the other.
+    const double *const values = solution.begin();
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        double *const u = membrane_values[i].begin();
+        for (unsigned int p = 0; p < membrane_values[i].locally_owned_size();
+             ++p)
+          u[p] = values[2 * p + i];
+        problem->laplace_matrix().vmult(stiffness_products[i],
+                                        membrane_values[i]);
+      }
 
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
@@ -46,33 +61,31 @@ namespace membranes
     // the terms of the obstacle problem for w, whose combination
     // (μ2 · membrane 1 + μ1 · membrane 2)/(μ1 + μ2) carries the rounding
     // error of forces of tension μ̄.
-    // The vectors of the locally owned DoFs, read at local_positions.
-    const double *const products = stiffness_product.begin();
-    const double *const loads    = mesh->load_vector().begin();
-    const double *const values   = solution.begin();
-    const auto         &vertices = mesh->vertices();
-    const double        mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
-    double              local_max = 0, local_contact_max = 0;
+    const auto  &vertices = problem->vertices();
+    const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
+    double       local_max = 0, local_contact_max = 0;
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const Vertex &a        = vertices[k];
-        const auto   &position = mesh->local_positions()[k];
+        const Vertex               &a = vertices[k];
+        const std::array<double, 2> stiffness{
+          {stiffness_term(0, k), stiffness_term(1, k)}};
+        const std::array<double, 2> loads{{load_term(0, k), load_term(1, k)}};
+        const auto                 &position = problem->local_positions()[k];
         for (unsigned int i = 0; i < 2; ++i)
           local_max = std::max({local_max,
-                                std::abs(products[position[i]]),
-                                std::abs(loads[position[i]]),
+                                std::abs(stiffness[i]),
+                                std::abs(loads[i]),
                                 data.mu[i] * a.stiffness_diagonal *
                                   std::abs(values[position[i]])});
-        local_contact_max = std::max(
-          {local_contact_max,
-           std::abs(mu2 * products[position[0]] - mu1 * products[position[1]]) /
-             M,
-           std::abs(mu2 * loads[position[0]] - mu1 * loads[position[1]]) / M,
-           data.mu_bar * a.stiffness_diagonal *
-             std::max(std::abs(values[position[0]]),
-                      std::abs(values[position[1]]))});
+        local_contact_max =
+          std::max({local_contact_max,
+                    std::abs(mu2 * stiffness[0] - mu1 * stiffness[1]) / M,
+                    std::abs(mu2 * loads[0] - mu1 * loads[1]) / M,
+                    data.mu_bar * a.stiffness_diagonal *
+                      std::max(std::abs(values[position[0]]),
+                               std::abs(values[position[1]]))});
       }
-    const MPI_Comm mpi_communicator = mesh->get_mpi_communicator();
+    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
     max_contact_force =
       Utilities::MPI::max(local_contact_max, mpi_communicator);
@@ -86,7 +99,7 @@ namespace membranes
     const typename DoFHandler<dim>::active_cell_iterator &cell,
     const unsigned int                                    i) const
   {
-    return mesh->load_mean_and_oscillation(cell, i);
+    return problem->load_mean_and_oscillation(cell, i);
   }
 
 
@@ -95,20 +108,28 @@ namespace membranes
   const std::vector<typename DiscreteAction<dim>::Vertex> &
   DiscreteAction<dim>::vertices() const
   {
-    return mesh->vertices();
+    return problem->vertices();
   }
 
 
 
   template <int dim>
-  void
-  DiscreteAction<dim>::fill_nodal_vector(VectorType &lambda_h) const
+  typename DiscreteAction<dim>::VectorType
+  DiscreteAction<dim>::lambda_h(
+    const AffineConstraints<double> &hanging_node_constraints) const
   {
-    lambda_h = 0;
+    VectorType nodal_values(problem->locally_owned_dofs(),
+                            problem->get_mpi_communicator());
     for (unsigned int k = 0; k < vertices().size(); ++k)
       for (const auto dof : vertices()[k].dof)
-        lambda_h[dof] = lambda(k);
-    lambda_h.compress(VectorOperation::insert);
+        nodal_values[dof] = lambda(k);
+    nodal_values.compress(VectorOperation::insert);
+    hanging_node_constraints.distribute(nodal_values);
+    VectorType ghosted(problem->locally_owned_dofs(),
+                       problem->locally_relevant_dofs(),
+                       problem->get_mpi_communicator());
+    ghosted = nodal_values;
+    return ghosted;
   }
 
 
@@ -130,7 +151,11 @@ namespace membranes
   DiscreteAction<dim>::stiffness_term(const unsigned int i,
                                       const unsigned int k) const
   {
-    return stiffness_product.begin()[mesh->local_positions()[k][i]];
+    // μ_i (A U_i)_a with the columns of the free DoFs, plus those of ∂ω:
+    // the loads minus the lifted loads, μ_i Σ_{b ∈ ∂ω} A_ab g_i(b).
+    const unsigned int p = problem->local_positions()[k][0] / 2;
+    return data.mu[i] * stiffness_products[i].begin()[p] +
+           (problem->loads(i).begin()[p] - problem->lifted_loads(i).begin()[p]);
   }
 
 
@@ -140,7 +165,7 @@ namespace membranes
   DiscreteAction<dim>::load_term(const unsigned int i,
                                  const unsigned int k) const
   {
-    return mesh->load_vector().begin()[mesh->local_positions()[k][i]];
+    return problem->loads(i).begin()[problem->local_positions()[k][0] / 2];
   }
 
 
@@ -175,15 +200,6 @@ namespace membranes
 
 
   template <int dim>
-  void
-  DiscreteAction<dim>::set_lambda_h(const VectorType &lambda_h)
-  {
-    lambda_h_vector = &lambda_h;
-  }
-
-
-
-  template <int dim>
   const DualCellQuadrature<dim> &
   DiscreteAction<dim>::dual_quadrature() const
   {
@@ -196,18 +212,20 @@ namespace membranes
   double
   DiscreteAction<dim>::lambda_h_value(
     const typename DoFHandler<dim>::active_cell_iterator &cell,
-    const unsigned int                                    v) const
+    const unsigned int                                    v,
+    const VectorType                                     &lambda_h) const
   {
-    return lambda_h_at_vertex(cell->vertex_dof_index(v, 0));
+    return lambda_h_at_vertex(cell->vertex_dof_index(v, 0), lambda_h);
   }
 
 
 
   template <int dim>
   double
-  DiscreteAction<dim>::lambda_h_at_vertex(const types::global_dof_index a) const
+  DiscreteAction<dim>::lambda_h_at_vertex(const types::global_dof_index a,
+                                          const VectorType &lambda_h) const
   {
-    return mesh->is_interior_vertex(a) ? (*lambda_h_vector)[a] : 0.;
+    return problem->is_interior_vertex(a) ? lambda_h[a] : 0.;
   }
 
 
@@ -216,6 +234,7 @@ namespace membranes
   void
   DiscreteAction<dim>::lambda_h_values(
     const typename DoFHandler<dim>::active_cell_iterator &cell,
+    const VectorType                                     &lambda_h,
     std::vector<double>                                  &values,
     std::vector<bool>                                    *in_omega_h) const
   {
@@ -225,9 +244,9 @@ namespace membranes
     std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
     for (const unsigned int v : cell->vertex_indices())
       {
-        vertex_values[v] = lambda_h_value(cell, v);
+        vertex_values[v] = lambda_h_value(cell, v, lambda_h);
         vertex_in_omega_h[v] =
-          mesh->is_interior_vertex(cell->vertex_dof_index(v, 0));
+          problem->is_interior_vertex(cell->vertex_dof_index(v, 0));
       }
     values.resize(dual_cell_quadrature.quadrature().size());
     if (in_omega_h)
@@ -246,11 +265,12 @@ namespace membranes
   template <int dim>
   void
   DiscreteAction<dim>::nodal_lambda_values(const FEValues<dim> &fe_values,
+                                           const VectorType    &lambda_h,
                                            std::vector<double> &values) const
   {
     values.resize(fe_values.n_quadrature_points);
-    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(
-      *lambda_h_vector, values);
+    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(lambda_h,
+                                                                 values);
   }
 
 

@@ -6,6 +6,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <membranes/cell_loop.h>
 #include <membranes/error_estimator.h>
+#include <membranes/flux_reconstruction.h>
 
 namespace membranes
 {
@@ -23,11 +24,12 @@ namespace membranes
   ErrorEstimator<dim>::residual_estimate(const DoFHandler<dim> &dof_handler,
                                          const VectorType &ghosted_solution,
                                          const DiscreteAction<dim> &action,
+                                         const VectorType          &lambda_h,
                                          Vector<double>            &indicators,
                                          const MPI_Comm mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    add_cell_terms(dof_handler, ghosted_solution, action, indicators);
+    add_cell_terms(dof_handler, ghosted_solution, action, lambda_h, indicators);
     add_jump_terms(dof_handler, ghosted_solution, indicators);
 
     double local_sum = 0;
@@ -46,6 +48,7 @@ namespace membranes
   ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
                                       const VectorType      &ghosted_solution,
                                       const DiscreteAction<dim> &action,
+                                      const VectorType          &lambda_h,
                                       Vector<double> &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
@@ -58,9 +61,11 @@ namespace membranes
     {
       Scratch(const Discretization<dim> &discretization,
               const DiscreteAction<dim> &action,
+              const VectorType          &lambda_h,
               const bool                 with_laplacians)
         : values(discretization,
                  action,
+                 lambda_h,
                  update_values | update_JxW_values |
                    (with_laplacians ? update_hessians : update_default))
       {
@@ -83,6 +88,7 @@ namespace membranes
       [&]() {
         return std::make_unique<Scratch>(discretization,
                                          action,
+                                         lambda_h,
                                          with_laplacians);
       },
       [&](const auto &cell, Scratch &scratch, NoCopy &) {
@@ -344,9 +350,11 @@ namespace membranes
   struct ErrorEstimator<dim>::FluxScratch
   {
     FluxScratch(const Discretization<dim> &discretization,
-                const DiscreteAction<dim> &action)
+                const DiscreteAction<dim> &action,
+                const VectorType          &lambda_h)
       : values(discretization,
                action,
+               lambda_h,
                update_values | update_gradients | update_jacobians |
                  update_JxW_values)
     {
@@ -399,6 +407,7 @@ namespace membranes
     const DoFHandler<dim>         &dof_handler,
     const VectorType              &ghosted_solution,
     const DiscreteAction<dim>     &action,
+    const VectorType              &lambda_h,
     const FluxReconstruction<dim> &flux_reconstruction,
     Vector<double>                &indicators,
     const MPI_Comm                 mpi_communicator) const
@@ -407,7 +416,9 @@ namespace membranes
     FluxTerms sums;
     run_on_cells<FluxTerms>(
       dof_handler,
-      [&]() { return std::make_unique<FluxScratch>(discretization, action); },
+      [&]() {
+        return std::make_unique<FluxScratch>(discretization, action, lambda_h);
+      },
       [&](const CellIterator &cell, FluxScratch &scratch, FluxTerms &terms) {
         terms = FluxTerms();
         if (!cell->is_locally_owned())
@@ -449,7 +460,9 @@ namespace membranes
   {
     scratch.values.reinit(cell, ghosted_solution);
     const FEValues<dim> &fe_values = scratch.values.fe_values;
-    action.nodal_lambda_values(fe_values, scratch.lambda);
+    action.nodal_lambda_values(fe_values,
+                               scratch.values.nodal_lambda_h,
+                               scratch.lambda);
     const std::array<double, 2> sign{{1., -1.}};
     const double                h_K = cell->diameter();
     FluxTerms                   terms;

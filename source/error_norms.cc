@@ -20,6 +20,7 @@ namespace membranes
   ErrorNorms<dim>::compute(const DoFHandler<dim>     &dof_handler,
                            const VectorType          &ghosted_solution,
                            const DiscreteAction<dim> &action,
+                           const VectorType          &lambda_h,
                            const MPI_Comm             mpi_communicator) const
   {
     // What one thread needs on a cell: u_h, λ_h, u, λ and the gradients
@@ -27,9 +28,11 @@ namespace membranes
     struct Scratch
     {
       Scratch(const Discretization<dim> &discretization,
-              const DiscreteAction<dim> &action)
+              const DiscreteAction<dim> &action,
+              const VectorType          &lambda_h)
         : values(discretization,
                  action,
+                 lambda_h,
                  update_values | update_gradients | update_quadrature_points |
                    update_JxW_values)
       {
@@ -51,7 +54,9 @@ namespace membranes
 
     run_on_cells<Squares>(
       dof_handler,
-      [&]() { return std::make_unique<Scratch>(discretization, action); },
+      [&]() {
+        return std::make_unique<Scratch>(discretization, action, lambda_h);
+      },
       [&](const auto &cell, Scratch &scratch, Squares &cell_squares) {
         cell_squares = Squares{};
         if (!cell->is_locally_owned())

@@ -16,11 +16,11 @@ namespace membranes
   {
     /** w = u1 − u2 from the two components of the solution. */
     template <int dim>
-    class GapPostprocessor : public DataPostprocessorScalar<dim>
+    class WPostprocessor : public DataPostprocessorScalar<dim>
     {
     public:
-      GapPostprocessor()
-        : DataPostprocessorScalar<dim>("u1_minus_u2", update_values)
+      WPostprocessor()
+        : DataPostprocessorScalar<dim>("w", update_values)
       {}
 
       void
@@ -53,16 +53,19 @@ namespace membranes
   FieldOutput<dim>::write(const unsigned int     cycle,
                           const DoFHandler<dim> &dof_handler,
                           const VectorType      &ghosted_solution,
-                          const VectorType      &contact_fields,
+                          const VectorType      &lambda_and_active_flags,
                           const Vector<double>  *indicators)
   {
     std::vector<std::string> files;
     if (parameters.write_vtu)
-      files.push_back(write_vtu(
-        cycle, dof_handler, ghosted_solution, contact_fields, indicators));
+      files.push_back(write_vtu(cycle,
+                                dof_handler,
+                                ghosted_solution,
+                                lambda_and_active_flags,
+                                indicators));
     if (parameters.write_nodal_values)
       files.push_back(write_nodal_values(
-        cycle, dof_handler, ghosted_solution, contact_fields));
+        cycle, dof_handler, ghosted_solution, lambda_and_active_flags));
     return files;
   }
 
@@ -73,16 +76,16 @@ namespace membranes
   FieldOutput<dim>::write_vtu(const unsigned int     cycle,
                               const DoFHandler<dim> &dof_handler,
                               const VectorType      &ghosted_solution,
-                              const VectorType      &contact_fields,
+                              const VectorType      &lambda_and_active_flags,
                               const Vector<double>  *indicators)
   {
-    const GapPostprocessor<dim> gap;
-    DataOut<dim>                data_out;
+    const WPostprocessor<dim> gap;
+    DataOut<dim>              data_out;
     data_out.attach_dof_handler(dof_handler);
     data_out.add_data_vector(ghosted_solution,
                              std::vector<std::string>{"u1", "u2"});
     data_out.add_data_vector(ghosted_solution, gap);
-    data_out.add_data_vector(contact_fields,
+    data_out.add_data_vector(lambda_and_active_flags,
                              std::vector<std::string>{"lambda_h",
                                                       "active_set"});
     const auto   &triangulation = dof_handler.get_triangulation();
@@ -185,10 +188,11 @@ namespace membranes
 
   template <int dim>
   std::string
-  FieldOutput<dim>::write_nodal_values(const unsigned int     cycle,
-                                       const DoFHandler<dim> &dof_handler,
-                                       const VectorType      &ghosted_solution,
-                                       const VectorType &contact_fields) const
+  FieldOutput<dim>::write_nodal_values(
+    const unsigned int     cycle,
+    const DoFHandler<dim> &dof_handler,
+    const VectorType      &ghosted_solution,
+    const VectorType      &lambda_and_active_flags) const
   {
     // The locally owned vertices, each once (by its u1 DoF), with their
     // values: x, y, u1, u2, λ_a, active set.
@@ -206,8 +210,8 @@ namespace membranes
                                      cell->vertex(v)[1],
                                      ghosted_solution[u1_dof],
                                      ghosted_solution[u2_dof],
-                                     contact_fields[u1_dof],
-                                     contact_fields[u2_dof]}};
+                                     lambda_and_active_flags[u1_dof],
+                                     lambda_and_active_flags[u2_dof]}};
           }
     std::vector<Row> rows;
     for (const auto &[dof, row] : owned_rows)

@@ -102,6 +102,7 @@ namespace membranes
   void
   FluxReconstruction<dim>::equilibrate(
     const AlignedVector<PatchTerms> &patch_terms,
+    const VectorType                &lambda_h,
     const AffineConstraints<double> &hanging_node_constraints,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator)
@@ -125,7 +126,7 @@ namespace membranes
 
     for (auto &kappa : sub_triangle_data)
       kappa.equilibrated = {};
-    solve_patches(local_members, patch_terms, remote);
+    solve_patches(local_members, patch_terms, lambda_h, remote);
     for (const auto &[process, buffer] :
          Utilities::MPI::some_to_some(mpi_communicator, remote.replies))
       for (unsigned int r = 0; r < remote.sent[process].size(); ++r)
@@ -239,6 +240,7 @@ namespace membranes
   FluxReconstruction<dim>::solve_patches(
     const std::vector<PatchMember>  &local_members,
     const AlignedVector<PatchTerms> &patch_terms,
+    const VectorType                &lambda_h,
     RemotePatches                   &remote)
   {
     // A patch is the run of members with the same a in local_members, from
@@ -261,6 +263,7 @@ namespace membranes
                     start[1],
                     local_members,
                     patch_terms,
+                    lambda_h,
                     remote,
                     scratch,
                     copy);
@@ -281,6 +284,7 @@ namespace membranes
     const unsigned int               end,
     const std::vector<PatchMember>  &local_members,
     const AlignedVector<PatchTerms> &patch_terms,
+    const VectorType                &lambda_h,
     RemotePatches                   &remote,
     PatchScratch                    &scratch,
     PatchCopy                       &copy) const
@@ -315,7 +319,7 @@ namespace membranes
           scratch.result.push_back(remote.replies.at(process).data() +
                                    r * result_size);
         }
-    scratch.problem.solve(action.lambda_h_at_vertex(a),
+    scratch.problem.solve(action.lambda_h_at_vertex(a, lambda_h),
                           scratch.patch,
                           scratch.result);
   }
@@ -340,6 +344,7 @@ namespace membranes
 
   template void
   FluxReconstruction<2>::equilibrate(const AlignedVector<PatchTerms> &,
+                                     const VectorType &,
                                      const AffineConstraints<double> &,
                                      const IndexSet &,
                                      const MPI_Comm);

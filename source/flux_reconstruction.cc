@@ -150,6 +150,7 @@ namespace membranes
   FluxReconstruction<dim>::reconstruct(
     const DoFHandler<dim>           &dof_handler,
     const VectorType                &ghosted_solution,
+    const VectorType                &lambda_h,
     const AffineConstraints<double> &hanging_node_constraints,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator)
@@ -172,6 +173,7 @@ namespace membranes
 
     set_half_edge_fluxes(compute_local_fluxes(ghosted_solution, patch_terms));
     equilibrate(patch_terms,
+                lambda_h,
                 hanging_node_constraints,
                 locally_owned_dofs,
                 mpi_communicator);
@@ -719,7 +721,7 @@ namespace membranes
 
   template <int dim>
   std::vector<DataOutBase::Patch<dim, dim>>
-  FluxReconstruction<dim>::patches() const
+  FluxReconstruction<dim>::patches(const VectorType &lambda_h) const
   {
     const auto            &triangles = basis.sub_triangles();
     SubTrianglePoints<dim> points(dual_cell_quadrature, true);
@@ -750,7 +752,7 @@ namespace membranes
                   const double det = std::abs(determinant(DF));
                   patch.data(0, j) = cell->vertex_index(triangles[s].vertex);
                   patch.data(1, j) =
-                    action.lambda_h_value(cell, triangles[s].vertex);
+                    action.lambda_h_value(cell, triangles[s].vertex, lambda_h);
                   for (unsigned int i = 0; i < 2; ++i)
                     {
                       const Tensor<1, dim> t =

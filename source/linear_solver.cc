@@ -14,7 +14,6 @@ namespace membranes
     : type(type)
     , mpi_communicator(mpi_communicator)
     , use_direct(false)
-    , first_iterations(0)
   {}
 
 
@@ -38,28 +37,44 @@ namespace membranes
 
 
   template <int dim>
-  unsigned int
-  LinearSolver<dim>::solve(const MatrixType &matrix,
-                           VectorType       &x,
-                           const VectorType &rhs,
-                           const double      tolerance,
-                           const MatrixType *mesh_matrix)
+  bool
+  LinearSolver<dim>::is_direct() const
   {
-    if (use_direct)
-      {
-        solve_direct(matrix, x, rhs);
-        return 0;
-      }
-    return solve_cg_amg(matrix, x, rhs, tolerance, mesh_matrix);
+    return use_direct;
+  }
+
+
+
+  template <int dim>
+  void
+  LinearSolver<dim>::initialize_preconditioner(const MatrixType &matrix)
+  {
+    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+    amg_data.elliptic        = true;
+    amg_data.constant_modes  = constant_modes;
+    amg_data.smoother_sweeps = 2;
+    amg.reset();
+    amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
+    amg->initialize(matrix, amg_data);
   }
 
 
 
   template <int dim>
   bool
-  LinearSolver<dim>::has_mesh_preconditioner() const
+  LinearSolver<dim>::has_preconditioner() const
   {
     return amg != nullptr;
+  }
+
+
+
+  template <int dim>
+  const TrilinosWrappers::PreconditionAMG &
+  LinearSolver<dim>::preconditioner() const
+  {
+    Assert(amg, ExcInternalError());
+    return *amg;
   }
 
 
@@ -86,51 +101,13 @@ namespace membranes
   void
   LinearSolver<dim>::solve_direct(const MatrixType &matrix,
                                   VectorType       &x,
-                                  const VectorType &rhs)
+                                  const VectorType &rhs) const
   {
     SolverControl                                  control;
     TrilinosWrappers::SolverDirect::AdditionalData data(false,
                                                         direct_solver_package);
     TrilinosWrappers::SolverDirect                 solver(control, data);
     solver.solve(matrix, x, rhs);
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  LinearSolver<dim>::solve_cg_amg(const MatrixType &matrix,
-                                  VectorType       &x,
-                                  const VectorType &rhs,
-                                  const double      tolerance,
-                                  const MatrixType *mesh_matrix)
-  {
-    const double rhs_norm = rhs.l2_norm();
-    if (rhs_norm == 0)
-      {
-        x = 0;
-        return 0;
-      }
-    const bool build = !amg || !mesh_matrix;
-    if (build)
-      {
-        TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
-        amg_data.elliptic        = true;
-        amg_data.constant_modes  = constant_modes;
-        amg_data.smoother_sweeps = 2;
-        amg = std::make_unique<TrilinosWrappers::PreconditionAMG>();
-        amg->initialize(mesh_matrix ? *mesh_matrix : matrix, amg_data);
-      }
-
-    SolverControl        control(10000, std::max(tolerance, 1e-14 * rhs_norm));
-    SolverCG<VectorType> cg(control);
-    cg.solve(matrix, x, rhs, *amg);
-    const unsigned int iterations = control.last_step();
-    if (build)
-      first_iterations = iterations;
-    if (!mesh_matrix || iterations > 2 * first_iterations + rebuild_slack)
-      amg.reset();
-    return iterations;
   }
 
 

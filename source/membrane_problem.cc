@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <membranes/error_estimator.h>
+#include <membranes/error_norms.h>
+#include <membranes/flux_reconstruction.h>
 #include <membranes/membrane_problem.h>
 #include <unistd.h>
 
@@ -23,7 +26,8 @@ namespace membranes
     , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
                                             mpi_communicator))
     , dof_handler(*triangulation)
-    , mesh_operator(discretization, data)
+    , scalar_dof_handler(*triangulation)
+    , discrete_problem(discretization, data)
     , active_set(parameters.solver, discretization, data, mpi_communicator)
     , action(discretization, data)
     , active_set_solver(parameters.solver,
@@ -32,15 +36,23 @@ namespace membranes
                         pcout,
                         computing_timer,
                         mpi_communicator)
-    , error_norms(discretization, data)
-    , flux_reconstruction(discretization, data, action)
-    , error_estimator(discretization, data)
+    , flux_reconstruction(
+        computes_fluxes() ?
+          std::make_unique<FluxReconstruction<dim>>(discretization,
+                                                    data,
+                                                    action) :
+          nullptr)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
     , output_directory(parameters.output.directory,
                        provenance,
                        mpi_communicator)
   {}
+
+
+
+  template <int dim>
+  MembraneProblem<dim>::~MembraneProblem() = default;
 
 
 
@@ -146,9 +158,9 @@ namespace membranes
 
   /**
    * DoFs of (u1, u2), the index sets of the step-40 layout, the hanging node
-   * constraints, and the operator of the mesh (MeshOperator: the Laplacian,
-   * the loads, the vertices of the dual mesh), which the discrete action and
-   * the solver's systems read.
+   * constraints, and the discrete problem of the mesh (DiscreteProblem: the
+   * Laplacian, the loads, the vertices of the dual mesh), which the discrete
+   * action and the solver's systems read.
    */
   template <int dim>
   void
@@ -164,13 +176,17 @@ namespace membranes
                                             hanging_node_constraints);
     hanging_node_constraints.close();
 
-    mesh_operator.reinit(dof_handler,
-                         hanging_node_constraints,
-                         locally_owned_dofs,
-                         locally_relevant_dofs,
-                         mpi_communicator);
-    action.reinit(mesh_operator);
-    active_set_solver.setup(mesh_operator);
+    scalar_dof_handler.distribute_dofs(discretization.fe->base_element(0));
+
+    discrete_problem.reinit(dof_handler,
+                            hanging_node_constraints,
+                            scalar_dof_handler,
+                            mpi_communicator);
+    action.reinit(discrete_problem);
+    active_set_solver.setup(discrete_problem,
+                            dof_handler,
+                            hanging_node_constraints,
+                            scalar_dof_handler);
 
     solution.reinit(locally_owned_dofs, mpi_communicator);
     ghosted_solution.reinit(locally_owned_dofs,
@@ -195,7 +211,7 @@ namespace membranes
     if (!distributed_transfer && !serial_transfer)
       {
         solution = 0;
-        active_set.reinit(mesh_operator);
+        active_set.reinit(discrete_problem);
         return;
       }
 
@@ -229,7 +245,7 @@ namespace membranes
     solution         = interpolated[0];
     ghosted_solution = interpolated[0];
     lambda_h         = interpolated[1];
-    active_set.reinit(mesh_operator, ghosted_solution, lambda_h);
+    active_set.reinit(discrete_problem, ghosted_solution, lambda_h);
   }
 
 
@@ -283,19 +299,6 @@ namespace membranes
 
 
 
-  /** λ_h: λ_a of V_h, and on hanging vertices by their constraints. */
-  template <int dim>
-  void
-  MembraneProblem<dim>::compute_lambda_h()
-  {
-    VectorType owned_lambda(locally_owned_dofs, mpi_communicator);
-    action.fill_nodal_vector(owned_lambda);
-    hanging_node_constraints.distribute(owned_lambda);
-    lambda_h = owned_lambda;
-  }
-
-
-
   /**
    * λ_h, and the discrete identities of §4.1 measured on the solution:
    * - Prop. 12: the two formulas of (4.5) agree, max_a |λ_1a − λ_2a| d_a,
@@ -307,8 +310,7 @@ namespace membranes
   void
   MembraneProblem<dim>::postprocess()
   {
-    compute_lambda_h();
-    action.set_lambda_h(lambda_h);
+    lambda_h = action.lambda_h(hanging_node_constraints);
 
     const KKTDefects defects = active_set.kkt_defects(action, ghosted_solution);
     const double     force_scale =
@@ -343,15 +345,17 @@ namespace membranes
     if (data.exact_solution_known())
       {
         TimerOutput::Scope scope(computing_timer, "errors");
-        const auto         errors = error_norms.compute(dof_handler,
-                                                ghosted_solution,
-                                                action,
-                                                mpi_communicator);
-        record.err_u1_H1          = errors.u_H1[0];
-        record.err_u2_H1          = errors.u_H1[1];
-        record.err_u1_L2          = errors.u_L2[0];
-        record.err_u2_L2          = errors.u_L2[1];
-        record.err_lambda_L2      = errors.lambda_L2;
+        const auto         errors = ErrorNorms<dim>(discretization, data)
+                              .compute(dof_handler,
+                                       ghosted_solution,
+                                       action,
+                                       lambda_h,
+                                       mpi_communicator);
+        record.err_u1_H1     = errors.u_H1[0];
+        record.err_u2_H1     = errors.u_H1[1];
+        record.err_u1_L2     = errors.u_L2[0];
+        record.err_u2_L2     = errors.u_L2[1];
+        record.err_lambda_L2 = errors.lambda_L2;
         record.err_energy =
           std::sqrt(data.mu[0] * errors.u_H1[0] * errors.u_H1[0] +
                     data.mu[1] * errors.u_H1[1] * errors.u_H1[1]);
@@ -375,43 +379,11 @@ namespace membranes
 
 
   /**
-   * The fluxes t_ih of §4.2 and σ_ih, if computes_fluxes(); with
-   * `Output/Flux reconstruction`, the defects of (4.17), (4.18) and of the
-   * balance of Lemma 17 for the report.
-   */
-  template <int dim>
-  void
-  MembraneProblem<dim>::reconstruct_fluxes()
-  {
-    if (!computes_fluxes())
-      return;
-    TimerOutput::Scope scope(computing_timer, "flux");
-    flux_reconstruction.reconstruct(dof_handler,
-                                    ghosted_solution,
-                                    hanging_node_constraints,
-                                    locally_owned_dofs,
-                                    mpi_communicator);
-    if (!parameters.output.flux_reconstruction)
-      return;
-    const auto identities =
-      flux_reconstruction.identities(hanging_node_constraints,
-                                     locally_owned_dofs,
-                                     mpi_communicator);
-    record.measure_defect      = identities.measure_defect;
-    record.conservation_defect = identities.conservation_defect;
-    record.balance_defect      = identities.balance_defect;
-  }
-
-
-
-  /**
    * The residual estimator η and its indicators η_K², when it drives
    * adaptive refinement or a target estimator, or the exact solution is
-   * known, and the flux estimator and its parts with the fluxes; with the
-   * exact solution, their effectivity indices η / |||e|||. The indicators
-   * of `Refinement/Estimator` are kept for marking. Balanced stopping needs
-   * the residual estimator on every mesh. The time of the flux estimator
-   * counts as flux reconstruction time, the rest as estimator time.
+   * known (with its effectivity index η / |||e|||), or balanced stopping
+   * needs it on every mesh. Its indicators are kept for marking unless the
+   * flux estimator drives refinement (reconstruct_fluxes()).
    */
   template <int dim>
   void
@@ -425,66 +397,74 @@ namespace membranes
       parameters.refinement.estimator == Parameters::Estimator::flux;
     const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
-    if ((drives && !flux_drives) || data.exact_solution_known() || balanced)
-      {
-        TimerOutput::Scope scope(computing_timer, "estimate");
-        Vector<double>     residual_indicators;
-        record.estimator =
-          error_estimator.residual_estimate(dof_handler,
+    if (!(drives && !flux_drives) && !data.exact_solution_known() && !balanced)
+      return;
+    TimerOutput::Scope scope(computing_timer, "estimate");
+    Vector<double>     residual_indicators;
+    record.estimator = ErrorEstimator<dim>(discretization, data)
+                         .residual_estimate(dof_handler,
                                             ghosted_solution,
                                             action,
+                                            lambda_h,
                                             residual_indicators,
                                             mpi_communicator);
-        if (record.err_energy)
-          record.effectivity = *record.estimator / *record.err_energy;
-        if (!flux_drives)
-          indicators.swap(residual_indicators);
-      }
-    if (computes_fluxes())
-      {
-        TimerOutput::Scope scope(computing_timer, "flux");
-        Vector<double>     flux_indicators;
-        const auto         estimate = error_estimator.flux_estimate(dof_handler,
-                                                            ghosted_solution,
-                                                            action,
-                                                            flux_reconstruction,
-                                                            flux_indicators,
-                                                            mpi_communicator);
-        record.flux_estimator       = estimate.eta;
-        record.flux_estimator_flux  = estimate.flux;
-        record.flux_estimator_oscillation = estimate.oscillation;
-        record.flux_estimator_contact     = estimate.contact;
-        record.flux_estimator_boundary    = estimate.boundary;
-        if (record.err_energy)
-          record.flux_effectivity = estimate.eta / *record.err_energy;
-        if (flux_drives)
-          indicators.swap(flux_indicators);
-      }
+    if (record.err_energy)
+      record.effectivity = *record.estimator / *record.err_energy;
+    if (!flux_drives)
+      indicators.swap(residual_indicators);
   }
 
 
 
   /**
-   * λ_a in the u1 slot and the active set indicator (1 or 0) in the u2 slot
-   * of every vertex of V_h (ghosted), as FieldOutput writes them.
+   * The fluxes t_ih of §4.2 and σ_ih, if computes_fluxes(); with
+   * `Output/Flux reconstruction`, the defects of (4.17), (4.18) and of the
+   * balance of Lemma 17 for the report. Then the flux estimator and its
+   * parts, with its effectivity index when the exact solution is known; its
+   * indicators are kept for marking when it drives refinement.
    */
   template <int dim>
-  typename MembraneProblem<dim>::VectorType
-  MembraneProblem<dim>::contact_fields() const
+  void
+  MembraneProblem<dim>::reconstruct_fluxes()
   {
-    VectorType fields(locally_owned_dofs, mpi_communicator);
-    fields = 0;
-    for (const auto &a : action.vertices())
+    if (!computes_fluxes())
+      return;
+    TimerOutput::Scope scope(computing_timer, "flux");
+    flux_reconstruction->reconstruct(dof_handler,
+                                     ghosted_solution,
+                                     lambda_h,
+                                     hanging_node_constraints,
+                                     locally_owned_dofs,
+                                     mpi_communicator);
+    if (parameters.output.flux_reconstruction)
       {
-        fields[a.dof[0]] = lambda_h[a.dof[0]];
-        fields[a.dof[1]] = active_set.is_element(a.dof[0]) ? 1 : 0;
+        const auto identities =
+          flux_reconstruction->identities(hanging_node_constraints,
+                                          locally_owned_dofs,
+                                          mpi_communicator);
+        record.measure_defect      = identities.measure_defect;
+        record.conservation_defect = identities.conservation_defect;
+        record.balance_defect      = identities.balance_defect;
       }
-    fields.compress(VectorOperation::insert);
-    VectorType ghosted_fields(locally_owned_dofs,
-                              locally_relevant_dofs,
-                              mpi_communicator);
-    ghosted_fields = fields;
-    return ghosted_fields;
+
+    Vector<double> flux_indicators;
+    const auto     estimate = ErrorEstimator<dim>(discretization, data)
+                            .flux_estimate(dof_handler,
+                                           ghosted_solution,
+                                           action,
+                                           lambda_h,
+                                           *flux_reconstruction,
+                                           flux_indicators,
+                                           mpi_communicator);
+    record.flux_estimator             = estimate.eta;
+    record.flux_estimator_flux        = estimate.flux;
+    record.flux_estimator_oscillation = estimate.oscillation;
+    record.flux_estimator_contact     = estimate.contact;
+    record.flux_estimator_boundary    = estimate.boundary;
+    if (record.err_energy)
+      record.flux_effectivity = estimate.eta / *record.err_energy;
+    if (parameters.refinement.estimator == Parameters::Estimator::flux)
+      indicators.swap(flux_indicators);
   }
 
 
@@ -500,7 +480,7 @@ namespace membranes
   MembraneProblem<dim>::write_unconverged_iterate()
   {
     ghosted_solution = solution;
-    compute_lambda_h();
+    lambda_h         = action.lambda_h(hanging_node_constraints);
 
     Parameters::Output output = parameters.output;
     output.directory += "/unconverged";
@@ -512,7 +492,7 @@ namespace membranes
         .write(record.cycle,
                dof_handler,
                ghosted_solution,
-               contact_fields(),
+               active_set.lambda_and_flags(lambda_h),
                nullptr);
     return "the last iterate is in " + output.directory + " (" + files[0] +
            ", " + files[1] + "), not in the report";
@@ -533,12 +513,12 @@ namespace membranes
     field_output.write(cycle,
                        dof_handler,
                        ghosted_solution,
-                       contact_fields(),
+                       active_set.lambda_and_flags(lambda_h),
                        indicators.size() ? &indicators : nullptr);
     if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
-                                   flux_reconstruction.patches(),
-                                   flux_reconstruction.data_names());
+                                   flux_reconstruction->patches(lambda_h),
+                                   FluxReconstruction<dim>::data_names());
   }
 
 
@@ -660,6 +640,9 @@ namespace membranes
    * computing_timer: on several processes that of the slowest process (each
    * phase ends in communication). The flux reconstruction has a time only
    * where it was computed, the error norms only with an exact solution.
+   * (TimerOutput::print_wall_time_statistics() prints the minimum, mean and
+   * maximum over the processes to a stream; the report needs the maximum as
+   * a number in its row.)
    */
   template <int dim>
   void
@@ -760,8 +743,8 @@ namespace membranes
         }
         compute_errors();
 
-        reconstruct_fluxes();
         estimate_error();
+        reconstruct_fluxes();
         record_phase_times();
         // The phases of the method; not the error norms (time_errors).
         record.wall_time = record.time_setup + record.time_assembly +

@@ -1,7 +1,7 @@
 /**
  * @file
  * The discrete identities of §3–4 of the paper on three tiny meshes, with
- * the library's own classes (MeshOperator, ActiveSet, ActiveSetSolver,
+ * the library's own classes (DiscreteProblem, ActiveSet, ActiveSetSolver,
  * DiscreteAction, FluxReconstruction) against values computed by hand.
  *
  * <h3>The data</h3>
@@ -55,9 +55,9 @@
  *   d_a = 3 · (1/16) + (1/64)(1 + ½ + ½) + (1/64)(½) + (1/64)(½) = 15/64,
  *   d_b = 4 · (1/64) = 1/16.
  *
- * ∫|∇φ_a|² is, as MeshOperator::laplace_diagonal() documents, Σ_K A_K(a,a)
- * over the cells with a as a vertex, without condensation: 4 · 2/3 = 8/3
- * (the condensed hat has 2 + ½ + 1/6 + 1/6 = 17/6; see below). The same for
+ * ∫|∇φ_a|² is, as DiscreteProblem::Vertex::stiffness_diagonal documents, Σ_K
+ * A_K(a,a) over the cells with a as a vertex, without condensation: 4 · 2/3 =
+ * 8/3 (the condensed hat has 2 + ½ + 1/6 + 1/6 = 17/6; see below). The same for
  * b: 8/3. So
  *
  *   c_a = (2/3)(8/3)/(15/64) = 1024/135,   c_b = (2/3)(8/3)/(1/16) = 256/9.
@@ -117,9 +117,9 @@
 #include <membranes/active_set.h>
 #include <membranes/active_set_solver.h>
 #include <membranes/discrete_action.h>
+#include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
 #include <membranes/flux_reconstruction.h>
-#include <membranes/mesh_operator.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <string>
@@ -223,7 +223,8 @@ namespace
       , discretization(cell_type)
       , triangulation(make_triangulation<dim>(cell_type, mpi_communicator))
       , dof_handler(*triangulation)
-      , mesh_operator(discretization, data)
+      , scalar_dof_handler(*triangulation)
+      , discrete_problem(discretization, data)
       , action(discretization, data)
       , active_set(parameters.solver, discretization, data, mpi_communicator)
       , solver(parameters.solver,
@@ -247,11 +248,17 @@ namespace
                                            dof_handler,
                                            support_points);
 
-      mesh_operator.reinit(
-        dof_handler, constraints, owned_dofs, relevant_dofs, mpi_communicator);
-      action.reinit(mesh_operator);
-      active_set.reinit(mesh_operator);
-      solver.setup(mesh_operator);
+      scalar_dof_handler.distribute_dofs(discretization.fe->base_element(0));
+      discrete_problem.reinit(dof_handler,
+                              constraints,
+                              scalar_dof_handler,
+                              mpi_communicator);
+      action.reinit(discrete_problem);
+      active_set.reinit(discrete_problem);
+      solver.setup(discrete_problem,
+                   dof_handler,
+                   constraints,
+                   scalar_dof_handler);
 
       solution.reinit(owned_dofs, mpi_communicator);
       ghosted_solution.reinit(owned_dofs, relevant_dofs, mpi_communicator);
@@ -264,18 +271,14 @@ namespace
     {
       solver.solve(action, solution, active_set);
       ghosted_solution = solution;
-      VectorType owned_lambda(owned_dofs, mpi_communicator);
-      action.fill_nodal_vector(owned_lambda);
-      constraints.distribute(owned_lambda);
-      lambda_h = owned_lambda;
-      action.set_lambda_h(lambda_h);
+      lambda_h         = action.lambda_h(constraints);
     }
 
     /** The index in vertices() of the vertex of V_h at @p p. */
     unsigned int
     vertex_at(const Point<dim> &p) const
     {
-      const auto &vertices = mesh_operator.vertices();
+      const auto &vertices = discrete_problem.vertices();
       for (unsigned int k = 0; k < vertices.size(); ++k)
         if (support_points.at(vertices[k].dof[0]).distance(p) < 1e-12)
           return k;
@@ -303,10 +306,11 @@ namespace
     Discretization<dim>                           discretization;
     const std::unique_ptr<Triangulation<dim>>     triangulation;
     DoFHandler<dim>                               dof_handler;
+    DoFHandler<dim>                               scalar_dof_handler;
     IndexSet                                      owned_dofs, relevant_dofs;
     AffineConstraints<double>                     constraints;
     std::map<types::global_dof_index, Point<dim>> support_points;
-    MeshOperator<dim>                             mesh_operator;
+    DiscreteProblem<dim>                          discrete_problem;
     DiscreteAction<dim>                           action;
     ActiveSet<dim>                                active_set;
     ActiveSetSolver<dim>                          solver;
@@ -332,7 +336,7 @@ namespace
                        const std::string &name,
                        const double       u)
   {
-    const auto &a      = problem.mesh_operator.vertices()[k];
+    const auto &a      = problem.discrete_problem.vertices()[k];
     const auto &action = problem.action;
     // A wrong operator, load or solve (or boundary value) moves u_ih(a).
     check(name + ": u1h at the vertex", problem.ghosted_solution[a.dof[0]], u);
@@ -361,7 +365,8 @@ namespace
     check_true(name + ": the vertex is active",
                problem.active_set.is_element(a.dof[0]));
     check(name + ": (4.8) lambda_a (u1h - u2h)(a)",
-          action.lambda(k) * ActiveSet<dim>::gap(a, problem.ghosted_solution),
+          action.lambda(k) *
+            ActiveSet<dim>::nodal_w(a, problem.ghosted_solution),
           0,
           lambda_contact * std::abs(u));
   }
@@ -369,18 +374,18 @@ namespace
 
 
   /**
-   * d_a, ∫|∇φ_a|² (as MeshOperator sums it) and c_a at the vertex @p a of
+   * d_a, ∫|∇φ_a|² (as DiscreteProblem sums it) and c_a at the vertex @p a of
    * @p problem against the hand values. A scaled or unlumped mass moves
    * d_a; a wrong stiffness diagonal ∫|∇φ_a|²; μ1 or μ2 in place of μ̄, or
    * a wrong d_a, moves c_a = μ̄ ∫|∇φ_a|² / d_a.
    */
   void
-  check_vertex_data(const TinyProblem               &problem,
-                    const MeshOperator<dim>::Vertex &a,
-                    const std::string               &name,
-                    const double                     d_a,
-                    const double                     stiffness,
-                    const double                     c_a)
+  check_vertex_data(const TinyProblem                  &problem,
+                    const DiscreteProblem<dim>::Vertex &a,
+                    const std::string                  &name,
+                    const double                        d_a,
+                    const double                        stiffness,
+                    const double                        c_a)
   {
     check(name + ": d_a = int phi_a", a.dual_cell_measure, d_a);
     check(name + ": int |grad phi_a|^2", a.stiffness_diagonal, stiffness);
@@ -403,7 +408,7 @@ namespace
                         make_mesh,
                         f1_contact,
                         f2_contact);
-    const auto &vertices = problem.mesh_operator.vertices();
+    const auto &vertices = problem.discrete_problem.vertices();
     // V_h: a boundary vertex counted as interior, or a missing vertex.
     check("Q1 2x2: |V_h| (one interior vertex)", vertices.size(), 1);
     const unsigned int k = problem.vertex_at(Point<dim>(0.5, 0.5));
@@ -435,7 +440,7 @@ namespace
                       f2_apart);
     apart.solve();
     const unsigned int ka = apart.vertex_at(Point<dim>(0.5, 0.5));
-    const auto        &b  = apart.mesh_operator.vertices()[ka];
+    const auto        &b  = apart.discrete_problem.vertices()[ka];
     // A vertex kept in contact where the membranes separate.
     check_true("Q1 2x2, apart: vertex a is inactive",
                !apart.active_set.is_element(b.dof[0]));
@@ -452,7 +457,7 @@ namespace
           2.);
     check("Q1 2x2, apart: (4.8) lambda_a (u1h - u2h)(a)",
           apart.action.lambda(ka) *
-            ActiveSet<dim>::gap(b, apart.ghosted_solution),
+            ActiveSet<dim>::nodal_w(b, apart.ghosted_solution),
           0,
           2. * 15. / 64.);
   }
@@ -476,7 +481,7 @@ namespace
       },
       f1_contact,
       f2_contact);
-    const auto &vertices = problem.mesh_operator.vertices();
+    const auto &vertices = problem.discrete_problem.vertices();
     // V_h = {a, b}: a hanging vertex taken into V_h.
     check("Q1 hanging: |V_h| (hanging vertices excluded)", vertices.size(), 2);
     const unsigned int ka = problem.vertex_at(Point<dim>(0.5, 0.5));
@@ -532,7 +537,7 @@ namespace
       },
       f1_contact,
       f2_contact);
-    const auto &vertices = problem.mesh_operator.vertices();
+    const auto &vertices = problem.discrete_problem.vertices();
     check("P1 4 triangles: |V_h|", vertices.size(), 1);
     const unsigned int k = problem.vertex_at(Point<dim>(0.5, 0.5));
     const auto        &a = vertices[k];
@@ -555,6 +560,7 @@ namespace
     // The dual cell D_a and div t_ih, from the sub-triangles of S_h.
     problem.flux_reconstruction.reconstruct(problem.dof_handler,
                                             problem.ghosted_solution,
+                                            problem.lambda_h,
                                             problem.constraints,
                                             problem.owned_dofs,
                                             problem.mpi_communicator);
@@ -563,7 +569,7 @@ namespace
       if (problem.triangulation->get_vertices()[v].distance(
             Point<dim>(0.5, 0.5)) < 1e-12)
         a_vertex = v;
-    const auto patches = problem.flux_reconstruction.patches();
+    const auto patches = problem.flux_reconstruction.patches(problem.lambda_h);
     const auto names   = FluxReconstruction<dim>::data_names();
     const auto column  = [&](const std::string &name) {
       return std::find(names.begin(), names.end(), name) - names.begin();

@@ -5,8 +5,8 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discrete_action.h>
+#include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
-#include <membranes/mesh_operator.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <optional>
@@ -181,8 +181,8 @@ namespace membranes
    * initial value on a new mesh, its update from an iterate, and the
    * constraint lines it imposes.
    *
-   * With W_a = u1h(a) − u2h(a) (gap()) and the nodal multiplier Λ_a = λ_a of
-   * (4.5), the active set is
+   * With W_a = u1h(a) − u2h(a) (nodal_w()) and the nodal multiplier Λ_a = λ_a
+   * of (4.5), the active set is
    *
    *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a
    *
@@ -269,16 +269,16 @@ namespace membranes
   {
   public:
     using VectorType = TrilinosWrappers::MPI::Vector;
-    using Vertex     = typename MeshOperator<dim>::Vertex;
+    using Vertex     = typename DiscreteProblem<dim>::Vertex;
 
     ActiveSet(const Parameters::Solver  &parameters,
               const Discretization<dim> &discretization,
               const ProblemData<dim>    &data,
               const MPI_Comm             mpi_communicator);
 
-    /** No active vertex on the mesh of @p mesh_operator (the first mesh). */
+    /** No active vertex on the mesh of @p discrete_problem (the first mesh). */
     void
-    reinit(const MeshOperator<dim> &mesh_operator);
+    reinit(const DiscreteProblem<dim> &discrete_problem);
 
     /**
      * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
@@ -287,9 +287,9 @@ namespace membranes
      * round-off; it starts inactive, as every vertex of the first mesh does.
      */
     void
-    reinit(const MeshOperator<dim> &mesh_operator,
-           const VectorType        &ghosted_solution,
-           const VectorType        &ghosted_lambda_h);
+    reinit(const DiscreteProblem<dim> &discrete_problem,
+           const VectorType           &ghosted_solution,
+           const VectorType           &ghosted_lambda_h);
 
     /** Whether the vertex with u1 DoF @p dof (locally owned) is active. */
     bool
@@ -313,9 +313,17 @@ namespace membranes
     IndexSet
     locally_relevant() const;
 
+    /**
+     * λ_a of @p lambda_h in the u1 slot and the active set indicator (1 or
+     * 0) in the u2 slot of every vertex of V_h, zero elsewhere (ghosted), as
+     * FieldOutput writes them.
+     */
+    VectorType
+    lambda_and_flags(const VectorType &lambda_h) const;
+
     /** W_a = u1h(a) − u2h(a) of @p solution (a locally owned). */
     static double
-    gap(const Vertex &a, const VectorType &solution);
+    nodal_w(const Vertex &a, const VectorType &solution);
 
     /** c_a = μ̄ ∫|∇φ_a|² / d_a. */
     double
@@ -374,8 +382,8 @@ namespace membranes
      * The locally owned vertices whose status the test wants to change on
      * the iterate predicted from @p solution by n_prediction_sweeps sweeps
      * of projected Jacobi; at the vertices where that test is within the
-     * band, those of @p plain_changes. Leaves the λ_a of the prediction in
-     * `prediction`.
+     * band, those of @p plain_changes. Leaves the λ_a of the predicted iterate
+     * in `predicted_action`.
      */
     std::vector<StatusChange>
     predicted_changes(const VectorType                &solution,
@@ -384,13 +392,13 @@ namespace membranes
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
 
-    SmartPointer<const MeshOperator<dim>> mesh;
+    const DiscreteProblem<dim> *problem;
     /** The locally owned active vertices. */
     IndexSet active_vertices;
     /** The sets visited on this mesh. */
     ActiveSetHistory history;
     /** λ_a of the predicted iterate (not that of the iterate itself). */
-    DiscreteAction<dim> prediction;
+    DiscreteAction<dim> predicted_action;
   };
 } // namespace membranes
 

@@ -6,17 +6,57 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/active_set.h>
-#include <membranes/active_set_system.h>
 #include <membranes/discrete_action.h>
+#include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
-#include <membranes/mesh_operator.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 #include <memory>
+#include <optional>
 
 namespace membranes
 {
   using namespace dealii;
+
+  /** What one solve of the active set method did. */
+  struct ActiveSetStatistics
+  {
+    unsigned int iterations        = 0; ///< Active set iterations.
+    unsigned int linear_iterations = 0; ///< CG iterations, summed.
+    double       kkt_residual      = 0; ///< Relative KKT residual at the end.
+    /**
+     * With balanced stopping: the estimates η_lin and η_alg of
+     * ActiveSetSolver at the end, in the energy norm.
+     */
+    std::optional<double> linearization_estimate, algebraic_estimate;
+  };
+
+
+
+  /**
+   * The residual norms at which the linear solves of one iteration stop.
+   *
+   * The linear problem of an iteration splits exactly (DecoupledSystem)
+   * into the problem for s = μ1 u1 + μ2 u2, whose residual at a vertex is
+   * r_S,a = (λ_1a − λ_2a) d_a (Prop. 12), and the obstacle problem for
+   * w = u1 − u2, whose residual at an inactive vertex is r_W,a = λ_a d_a
+   * (DiscreteAction::lambda()). The two are of different sizes,
+   * forces of tension μ1 + μ2 and μ̄ = μ1μ2/(μ1 + μ2), eight orders apart
+   * for a tension ratio of 1e8; each gets its own bound on the Euclidean
+   * norm of its residual, which also bounds each nodal residual.
+   */
+  struct LinearTolerances
+  {
+    double sum;     ///< Bound of ‖r_S‖₂.
+    double contact; ///< Bound of ‖r_W‖₂ (inactive vertices).
+  };
+
+
+
+  template <int dim>
+  class ActiveSetSystem;
+
+
 
   /**
    * The active set method stopped without a converged iterate: at
@@ -131,9 +171,18 @@ namespace membranes
                     TimerOutput               &timer,
                     const MPI_Comm             mpi_communicator);
 
-    /** The linear systems for the mesh of @p mesh_operator. */
+    ~ActiveSetSolver();
+
+    /**
+     * The linear systems for the mesh of @p discrete_problem, on
+     * @p dof_handler of (u1, u2) with @p hanging_node_constraints and on
+     * @p scalar_dof_handler.
+     */
     void
-    setup(const MeshOperator<dim> &mesh_operator);
+    setup(const DiscreteProblem<dim>      &discrete_problem,
+          const DoFHandler<dim>           &dof_handler,
+          const AffineConstraints<double> &hanging_node_constraints,
+          const DoFHandler<dim>           &scalar_dof_handler);
 
     /**
      * Run the active set method from the initial guess @p solution (locally
@@ -151,7 +200,7 @@ namespace membranes
 
   private:
     /** Where the method stands in its stopping test on one mesh. */
-    struct Stopping
+    struct StoppingState
     {
       /** Balanced stopping, and γ η̃. */
       bool   balanced;
@@ -178,7 +227,7 @@ namespace membranes
 
     /** The stopping test of a mesh whose expected error is @p expected_error.
      */
-    Stopping
+    StoppingState
     start(const double expected_error) const;
 
     /**
@@ -189,7 +238,7 @@ namespace membranes
     compute_action(DiscreteAction<dim> &action,
                    const VectorType    &solution,
                    VectorType          &ghosted_solution,
-                   Stopping            &stopping) const;
+                   StoppingState       &stopping) const;
 
     /**
      * Move @p active_set on after the iterate @p solution of iteration
@@ -202,7 +251,7 @@ namespace membranes
            const VectorType                &solution,
            const std::vector<StatusChange> &changes,
            const unsigned int               iteration,
-           Stopping                        &stopping) const;
+           StoppingState                   &stopping) const;
 
     /**
      * The residual norms at which the linear solves stop: those that the
@@ -214,7 +263,7 @@ namespace membranes
      * algebraic error of γ η̃ / 2 in the energy norm.
      */
     LinearTolerances
-    linear_tolerances(const Stopping &stopping) const;
+    linear_tolerances(const StoppingState &stopping) const;
 
     /**
      * The KKT residual of the iterate @p solution with λ_a in @p action and,
@@ -224,7 +273,7 @@ namespace membranes
     evaluate(const DiscreteAction<dim> &action,
              const VectorType          &solution,
              const ActiveSet<dim>      &active_set,
-             const Stopping            &stopping,
+             const StoppingState       &stopping,
              Statistics                &statistics) const;
 
     /**
@@ -236,7 +285,7 @@ namespace membranes
     bool
     stops(const Statistics             &statistics,
           const types::global_dof_index n_changes,
-          Stopping                     &stopping) const;
+          StoppingState                &stopping) const;
 
     /** The line of the terminal for one iteration. */
     void
@@ -244,7 +293,7 @@ namespace membranes
                     const ActiveSet<dim>         &active_set,
                     const types::global_dof_index n_changes,
                     const unsigned int            linear_iterations,
-                    const Stopping               &stopping) const;
+                    const StoppingState          &stopping) const;
 
     /**
      * The squared residual of the equilibrium part of the KKT conditions at
@@ -278,7 +327,7 @@ namespace membranes
     TimerOutput              &timer;
     const MPI_Comm            mpi_communicator;
 
-    SmartPointer<const MeshOperator<dim>> mesh;
+    const DiscreteProblem<dim> *problem;
 
     /** The linear problem of one iteration, coupled or decoupled. */
     std::unique_ptr<ActiveSetSystem<dim>> system;

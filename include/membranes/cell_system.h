@@ -30,7 +30,7 @@ namespace membranes
    *   matrix(j, k) = μ_c A_K(v(j), v(k))  if c(j) = c(k), 0 otherwise,
    *   rhs(j)       = F_cK(v(j)),    lumped_mass(j) = m_K(v(j)).
    *
-   * MeshOperator assembles the operator and the loads of the mesh from the
+   * DiscreteProblem assembles the operator and the loads of the mesh from the
    * FESystem parts, once per mesh, and keeps the loads F_iK of each cell;
    * the systems of the active set method condense the loads of each cell
    * (the coupled one from the FESystem parts, the decoupled one from F_iK)

@@ -3,10 +3,10 @@
 
 #include <array>
 #include <deal.II/base/function.h>
+#include <deal.II/base/smartpointer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <membranes/active_set_system.h>
-#include <membranes/matrix_rows.h>
 #include <memory>
 #include <vector>
 
@@ -15,8 +15,8 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * The linear problem of one active set iteration, solved on the sum and
-   * the difference of the membranes (`Solver/Method = decoupled`).
+   * The linear problem of one active set iteration, solved on the s and
+   * the w of the membranes (`Solver/Method = decoupled`).
    *
    * <h3>The decoupling of the discrete problem</h3>
    * Let A be the stiffness matrix of the Laplacian on the scalar P1/Q1
@@ -28,7 +28,7 @@ namespace membranes
    *   W_a = U1_a − U2_a ≥ 0,   Λ_a ≥ 0,   W_a Λ_a = 0,
    *
    * with U1 = g_h, U2 = g2_h on ∂ω. For constant μ1, μ2 (M = μ1 + μ2,
-   * μ̄ = μ1μ2/M) the sum of the two equations and μ̄ times the difference of
+   * μ̄ = μ1μ2/M) the s of the two equations and μ̄ times the w of
    * the equations divided by μ_i are
    *
    *   A S = F1 + F2,                          S = μ1 U1 + μ2 U2,
@@ -48,26 +48,41 @@ namespace membranes
    * problem, on the unconstrained interior vertices.
    *
    * <h3>What one iteration does</h3>
-   * The Laplacian is not assembled again: A is the block μ1 A of the
-   * operator of the mesh (MeshOperator) divided by μ1. The first solve() of
-   * a mesh condenses the cell loads of the mesh into the right-hand sides
-   * of S and W (the boundary values lifted by A_K and μ̄ A_K on the cells
-   * at ∂ω; the hanging node constraints and the boundary values are the
-   * same lines for S and for W) and solves the linear problem for S from
-   * the initial guess. Every
-   * solve() then imposes W_a = 0 on the active set: it writes μ̄ A into the
-   * matrix of W with the rows and columns of the active vertices
-   * eliminated (what condensing an AffineConstraints line without entries
-   * does), the right-hand side zeroed there, in one pass over the entries
-   * of the mesh's operator; it solves the obstacle problem's linear system
-   * for W (inactive vertices: Λ_a = 0), and writes U1, U2 into the
-   * solution of the two-component FESystem. ActiveSetSolver computes λ_a by
-   * (4.5), and ActiveSet the next active set and the KKT residual, from it
-   * exactly as for the coupled system: the test Λ_a − c_a W_a > 0 with
-   * c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of this obstacle problem,
-   * whose diagonal is μ̄ A_aa.
+   * Both scalar problems have the matrix A of the mesh (DiscreteProblem:
+   * condensed with the hanging node constraints and the boundary values,
+   * which are the same lines for S and for W), and their right-hand sides
+   * are combinations of the lifted loads of the mesh, F_1 + F_2 for S and
+   * (μ2 F_1 − μ1 F_2)/M for W; the first solve() of a mesh forms these and
+   * solves A S = F_1 + F_2 from the initial guess. Every solve() then
+   * imposes W_a = 0 on the active set and solves the obstacle problem's
+   * linear system for W (inactive vertices: Λ_a = 0), and writes U1, U2
+   * into the solution of the two-component FESystem. ActiveSetSolver
+   * computes λ_a by (4.5), and ActiveSet the next active set and the KKT
+   * residual, from it exactly as for the coupled system: the test
+   * Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of
+   * this obstacle problem, whose diagonal is μ̄ A_aa.
    *
-   * Both scalar problems live on one scalar DoFHandler (the base element of
+   * <h3>The active set: an operator, and a matrix for the preconditioner</h3>
+   * The matrix of W of an iteration is μ̄ A with the rows and columns of the
+   * active vertices eliminated (the constraints W_a = 0 condensed). CG does
+   * not need it as a matrix: it applies it as the operator
+   * Π (μ̄ A) Π + (I − Π), Π the projection that sets the entries of the
+   * active vertices to zero (RestrictedOperator), with the matrix A of the
+   * mesh. The AMG hierarchy does need a matrix, and the right one: the
+   * hierarchy of A itself, seen through Π, took 2 to 3 times the CG
+   * iterations on case M (Q1, 5.3·10⁵ DoFs: 46 and 29 against 16 and 11
+   * per active set iteration), because the restriction of A⁻¹ to the
+   * inactive vertices is not the inverse of the restriction of A. So the
+   * first iteration of a mesh (and one whose CG iterations exceed twice
+   * those of the one that built the hierarchy, plus rebuild_slack) condenses
+   * the matrix of W by AffineConstraints in a cell loop, as step-41 does,
+   * and builds the hierarchy from it; the following iterations, whose
+   * active sets differ from it near the free boundary only, reuse it
+   * through Π. The direct solver factorizes the matrix of W of every
+   * iteration. One matrix per problem and mesh: A (for S, λ_h and the
+   * operator of W) and the matrix of W.
+   *
+   * Both scalar problems live on the scalar DoFHandler (the base element of
    * the FESystem, on the same mesh and mapping), whose DoFs map one to one
    * to the vertices. Each is half the size of the coupled system, and S is
    * solved only once.
@@ -81,111 +96,87 @@ namespace membranes
     DecoupledSystem(const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,
                     const ProblemData<dim>    &data,
-                    TimerOutput               &timer,
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * The scalar DoFHandler on the mesh of @p mesh_operator, the constraints
-     * of S and of W, and one sparsity pattern for S and for W with any
-     * active set.
+     * The constraints of S and of W on @p scalar_dof_handler, and the
+     * right-hand sides of both from the lifted loads of @p problem.
      */
     void
-    setup(const MeshOperator<dim> &mesh_operator) override;
+    setup(const DiscreteProblem<dim>      &problem,
+          const DoFHandler<dim>           &dof_handler,
+          const AffineConstraints<double> &hanging_node_constraints,
+          const DoFHandler<dim>           &scalar_dof_handler) override;
 
     /**
-     * W for @p active_set, and (U1, U2) from S and W into @p solution. The
-     * first solve on a mesh first makes the right-hand sides and solves for
-     * S (solve_sum()).
+     * S and W of @p solution on the first iteration of a mesh; the right-hand
+     * side of W for @p active_set, with W = 0 at its vertices, and the
+     * matrix of W when the solve needs it.
      */
     void
-    solve(const IndexSet         &active_set,
-          VectorType             &solution,
+    assemble(const IndexSet &active_set, VectorType &solution) override;
+
+    /**
+     * W, and (U1, U2) from S and W into @p solution. The first solve on a
+     * mesh first solves for S (solve_s()).
+     */
+    void
+    solve(VectorType             &solution,
           const LinearTolerances &tolerances,
           ActiveSetStatistics    &statistics) override;
 
-    /**
-     * Also the scalar DoFHandler, its constraints, the matrices of W, S, W
-     * and the right-hand side of W.
-     */
+    /** The constraints, vectors and the AMG hierarchy of this mesh. */
     void
     clear() override;
 
   private:
-    /**
-     * The DoF of u_i (i = 0, 1) at the vertex of scalar DoF @p k; the
-     * scalar DoF of a DoF j of (u1, u2) is j / 2.
-     */
-    static types::global_dof_index
-    membrane_dof(const types::global_dof_index k, const unsigned int i);
+    /** CG iterations a reused hierarchy may need beyond twice its first. */
+    static constexpr unsigned int rebuild_slack = 5;
 
     /**
-     * The right-hand sides of S (into system_rhs) and of W (without the
-     * contact constraints), condensed with the hanging node constraints and
-     * the boundary values of each, from the loads and the operator of the
-     * mesh.
+     * obstacle_matrix = μ̄ A with the constraints W_a = 0 of @p active_set
+     * (u1 DoFs of the locally relevant active vertices) condensed as
+     * AffineConstraints condenses them in a cell loop: their rows and
+     * columns eliminated.
      */
     void
-    make_right_hand_sides();
+    make_obstacle_matrix(const IndexSet &active_set);
 
-    /**
-     * @p matrix = @p coefficient · A, condensed with the hanging node
-     * constraints and the boundary values, and with the rows and columns of
-     * @p active_scalar_dofs (locally relevant) eliminated: their
-     * off-diagonal entries zero. @p matrix has the sparsity pattern that
-     * setup() made.
-     */
+    /** S of this mesh, from A S = F_1 + F_2, to the residual @p tolerance. */
     void
-    make_operator(const double                    coefficient,
-                  const IndexSet                 &active_scalar_dofs,
-                  TrilinosWrappers::SparseMatrix &matrix) const;
+    solve_s(const double tolerance, ActiveSetStatistics &statistics);
 
-    /**
-     * S and W of the initial guess @p solution, the right-hand sides
-     * (make_right_hand_sides()), then S of this mesh, from A S = F1 + F2.
-     */
-    void
-    solve_sum(const VectorType       &solution,
-              const LinearTolerances &tolerances,
-              ActiveSetStatistics    &statistics);
-
-    /** μ1 g + μ2 g2 and g − g2: the boundary values of S and of W. */
-    const std::unique_ptr<Function<dim>> sum_boundary_values;
-    const std::unique_ptr<Function<dim>> difference_boundary_values;
-
-    DoFHandler<dim> scalar_dof_handler;
-    IndexSet        locally_owned_scalar_dofs;
-    IndexSet        locally_relevant_scalar_dofs;
+    SmartPointer<const DoFHandler<dim>> dof_handler;
 
     /** Hanging node constraints and the boundary values of S, of W. */
-    AffineConstraints<double> sum_constraints;
-    AffineConstraints<double> difference_constraints;
-    /** The scalar DoFs these constrain (the same for S and W). */
-    IndexSet constrained_scalar_dofs;
+    AffineConstraints<double> s_constraints;
+    AffineConstraints<double> w_constraints;
 
-    /**
-     * The local column of the matrices of S and W of each local column of
-     * the mesh's operator (−1 where they have none).
-     */
-    std::vector<int> column_of_operator_column;
-
-    /**
-     * The load of W ((μ2 F1 − μ1 F2)/M, its boundary values lifted by μ̄ A),
-     * condensed with the constraints of the mesh: made once per mesh.
-     */
-    VectorType difference_rhs;
-
-    /**
-     * The matrix of S, then that of W at the iteration whose AMG hierarchy
-     * the following iterations of this mesh reuse (LinearSolver); those
-     * write theirs into system_matrix.
-     */
-    TrilinosWrappers::SparseMatrix preconditioner_matrix;
+    /** The lifted loads of S and of W, made once per mesh. */
+    VectorType s_rhs;
+    VectorType w_rhs;
 
     /** S = μ1 U1 + μ2 U2 and W = U1 − U2 (locally owned). */
-    VectorType sum;
-    VectorType difference;
+    VectorType s;
+    VectorType w;
+    /**
+     * The positions of the locally owned active vertices in the scalar
+     * vectors, and the right-hand side of W, of the last assemble().
+     */
+    std::vector<unsigned int> active_positions;
+    VectorType                rhs;
     /** Whether S has been solved for on this mesh. */
-    bool sum_solved;
+    bool s_solved;
+
+    /**
+     * The matrix of W, μ̄ A with the rows and columns of the active vertices
+     * eliminated, for the active set of the iteration that built the AMG
+     * hierarchy that the later iterations of the mesh reuse (the hierarchy
+     * refers to it), or of the current iteration for the direct solver.
+     */
+    TrilinosWrappers::SparseMatrix obstacle_matrix;
+    /** CG iterations of the solve that built the hierarchy. */
+    unsigned int hierarchy_iterations;
   };
 } // namespace membranes
 

@@ -6,9 +6,9 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
 #include <membranes/dual_cell_quadrature.h>
-#include <membranes/mesh_operator.h>
 #include <membranes/problem_data.h>
 #include <utility>
 #include <vector>
@@ -36,15 +36,16 @@ namespace membranes
    * λ_h is the function equal to λ_a on the dual cell D_a (a ∈ V_h); on the
    * pieces of a hanging vertex, the constraint-weighted mean of the λ_a of
    * its parents; zero on the pieces of boundary vertices, the strip ω \ ω_h.
-   * This class is its one home: errors, both estimators, the flux
-   * reconstruction and the output read λ_h through lambda_h_values() on the
-   * pieces of the DualCellQuadrature, or its nodal interpolant through
+   * lambda_h() returns its nodal values as a vector, which the driver keeps
+   * and hands to the errors, both estimators, the flux reconstruction and
+   * the output; they read it through lambda_h_values() on the pieces of the
+   * DualCellQuadrature, or its nodal interpolant through
    * nodal_lambda_values().
    *
    * The same nodal quantities are the multipliers of the active set solver:
    * λ_a d_a is the residual of membrane 1's equation at a.
    *
-   * V_h, d_a, the operator and the loads are those of the MeshOperator of
+   * V_h, d_a, the operator and the loads are those of the DiscreteProblem of
    * the mesh, assembled once per mesh; this class only applies them to a
    * solution. Everything is stored for the locally owned vertices of V_h
    * only, in the order of their u1 DoF index; the DoFs of the locally
@@ -58,18 +59,18 @@ namespace membranes
     using VectorType = TrilinosWrappers::MPI::Vector;
 
     /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
-    using Vertex = typename MeshOperator<dim>::Vertex;
+    using Vertex = typename DiscreteProblem<dim>::Vertex;
 
     DiscreteAction(const Discretization<dim> &discretization,
                    const ProblemData<dim>    &data);
 
     /**
-     * Work on the mesh of @p mesh_operator, which holds V_h, d_a, the
+     * Work on the mesh of @p discrete_problem, which holds V_h, d_a, the
      * operator and the loads of (4.5); it must live as long as this object
      * is used on that mesh.
      */
     void
-    reinit(const MeshOperator<dim> &mesh_operator);
+    reinit(const DiscreteProblem<dim> &discrete_problem);
 
     /**
      * Compute λ_a by (4.5) from both membranes for @p solution (locally
@@ -80,7 +81,7 @@ namespace membranes
     void
     compute(const VectorType &solution);
 
-    /** MeshOperator::load_mean_and_oscillation() of the mesh. */
+    /** DiscreteProblem::load_mean_and_oscillation() of the mesh. */
     std::pair<double, double>
     load_mean_and_oscillation(
       const typename DoFHandler<dim>::active_cell_iterator &cell,
@@ -91,36 +92,34 @@ namespace membranes
     vertices() const;
 
     /**
-     * Write λ_a into both DoF slots (u1 and u2) of every vertex a of V_h in
-     * @p lambda_h, a vector with the layout of the solution; zero
-     * elsewhere.
+     * λ_h of the last compute(): a ghosted vector with the layout of the
+     * solution, λ_a in both DoF slots (u1 and u2) of every vertex a of V_h,
+     * at a hanging vertex the mean given by @p hanging_node_constraints,
+     * zero on ∂ω.
      */
-    void
-    fill_nodal_vector(VectorType &lambda_h) const;
-
-    /**
-     * Use @p lambda_h (λ_a in the u1 slot of the interior vertices,
-     * distributed to the hanging vertices, ghosted)
-     * as λ_h; it must live as long as λ_h is read.
-     */
-    void
-    set_lambda_h(const VectorType &lambda_h);
+    VectorType
+    lambda_h(const AffineConstraints<double> &hanging_node_constraints) const;
 
     /** The quadrature on the pieces K ∩ D_a of every cell. */
     const DualCellQuadrature<dim> &
     dual_quadrature() const;
 
-    /** λ_h on the pieces K ∩ D_a of vertex @p v of @p cell. */
+    /**
+     * λ_h (@p lambda_h, as lambda_h() returns it) on the pieces K ∩ D_a of
+     * vertex @p v of @p cell.
+     */
     double
     lambda_h_value(const typename DoFHandler<dim>::active_cell_iterator &cell,
-                   const unsigned int v) const;
+                   const unsigned int                                    v,
+                   const VectorType &lambda_h) const;
 
     /**
      * λ_h on the pieces of the vertex whose u1 DoF is @p a (locally
      * relevant); zero if a is on ∂ω.
      */
     double
-    lambda_h_at_vertex(const types::global_dof_index a) const;
+    lambda_h_at_vertex(const types::global_dof_index a,
+                       const VectorType             &lambda_h) const;
 
     /**
      * λ_h at the points of dual_quadrature() on @p cell; with @p in_omega_h,
@@ -128,16 +127,18 @@ namespace membranes
      */
     void
     lambda_h_values(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                    const VectorType    &lambda_h,
                     std::vector<double> &values,
                     std::vector<bool>   *in_omega_h = nullptr) const;
 
     /**
      * The P1/Q1 function λ̃_h = Σ_a λ_a φ_a with the nodal values λ_a of
-     * λ_h (zero on ∂ω; at a hanging vertex the constraint-weighted mean),
-     * at the points of @p fe_values, reinit'ed on a cell.
+     * @p lambda_h (zero on ∂ω; at a hanging vertex the constraint-weighted
+     * mean), at the points of @p fe_values, reinit'ed on a cell.
      */
     void
     nodal_lambda_values(const FEValues<dim> &fe_values,
+                        const VectorType    &lambda_h,
                         std::vector<double> &values) const;
 
     /** λ_a from membrane i (0 or 1) for the k-th vertex of vertices(). */
@@ -196,14 +197,14 @@ namespace membranes
     const Discretization<dim>    &discretization;
     const ProblemData<dim>       &data;
     const DualCellQuadrature<dim> dual_cell_quadrature;
-    /** λ_h as given to set_lambda_h(). */
-    const VectorType *lambda_h_vector;
-
     /** The mesh data of (4.5). */
-    SmartPointer<const MeshOperator<dim>> mesh;
+    const DiscreteProblem<dim> *problem;
 
-    /** The product of the operator of the mesh with the last solution. */
-    VectorType stiffness_product;
+    /**
+     * U_i, the nodal values of membrane i of the last solution, and the
+     * products A U_i (locally owned scalar DoFs).
+     */
+    std::array<VectorType, 2> membrane_values, stiffness_products;
 
     double max_force;
     double max_contact_force;
@@ -222,15 +223,17 @@ namespace membranes
   template <int dim>
   struct DualCellValues
   {
-    DualCellValues(const Discretization<dim> &discretization,
-                   const DiscreteAction<dim> &action,
-                   const UpdateFlags          update_flags)
+    DualCellValues(const Discretization<dim>           &discretization,
+                   const DiscreteAction<dim>           &action,
+                   const TrilinosWrappers::MPI::Vector &lambda_h,
+                   const UpdateFlags                    update_flags)
       : fe_values(*discretization.mapping,
                   *discretization.fe,
                   action.dual_quadrature().quadrature(),
                   update_flags)
       , local_dofs(discretization.fe->n_dofs_per_cell())
       , action(action)
+      , nodal_lambda_h(lambda_h)
     {}
 
     /** Reinit on @p cell, with the nodal values of @p solution there. */
@@ -240,14 +243,15 @@ namespace membranes
     {
       fe_values.reinit(cell);
       cell->get_dof_values(solution, local_dofs.begin(), local_dofs.end());
-      action.lambda_h_values(cell, lambda_h, &in_omega_h);
+      action.lambda_h_values(cell, nodal_lambda_h, lambda_h, &in_omega_h);
     }
 
-    FEValues<dim>              fe_values;
-    std::vector<double>        local_dofs;
-    std::vector<double>        lambda_h;
-    std::vector<bool>          in_omega_h;
-    const DiscreteAction<dim> &action;
+    FEValues<dim>                        fe_values;
+    std::vector<double>                  local_dofs;
+    std::vector<double>                  lambda_h;
+    std::vector<bool>                    in_omega_h;
+    const DiscreteAction<dim>           &action;
+    const TrilinosWrappers::MPI::Vector &nodal_lambda_h;
   };
 } // namespace membranes
 

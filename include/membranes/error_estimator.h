@@ -9,13 +9,15 @@
 #include <deal.II/lac/vector.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
-#include <membranes/flux_reconstruction.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
 
 namespace membranes
 {
   using namespace dealii;
+
+  template <int dim>
+  class FluxReconstruction;
 
   /**
    * The two a posteriori estimators of the contact problem, selected by
@@ -141,23 +143,26 @@ namespace membranes
     /**
      * The residual estimator: fill @p indicators (indexed by
      * active_cell_index(), zero on cells not locally owned) with its η_K²
-     * and return η over all processes, with the λ_h of @p action.
+     * and return η over all processes, with @p lambda_h the λ_h of
+     * @p action (DiscreteAction::lambda_h()).
      */
     double
     residual_estimate(const DoFHandler<dim>     &dof_handler,
                       const VectorType          &ghosted_solution,
                       const DiscreteAction<dim> &action,
+                      const VectorType          &lambda_h,
                       Vector<double>            &indicators,
                       const MPI_Comm             mpi_communicator) const;
 
     /**
      * The flux estimator: the same with the equilibrated fluxes of
-     * @p flux_reconstruction and the nodal λ_a of @p action.
+     * @p flux_reconstruction and the nodal λ_a of @p lambda_h.
      */
     FluxEstimate
     flux_estimate(const DoFHandler<dim>         &dof_handler,
                   const VectorType              &ghosted_solution,
                   const DiscreteAction<dim>     &action,
+                  const VectorType              &lambda_h,
                   const FluxReconstruction<dim> &flux_reconstruction,
                   Vector<double>                &indicators,
                   const MPI_Comm                 mpi_communicator) const;
@@ -170,6 +175,7 @@ namespace membranes
     add_cell_terms(const DoFHandler<dim>     &dof_handler,
                    const VectorType          &ghosted_solution,
                    const DiscreteAction<dim> &action,
+                   const VectorType          &lambda_h,
                    Vector<double>            &indicators) const;
 
     /** The boundary data part of FluxEstimate. */

@@ -40,11 +40,12 @@ namespace membranes
     ErrorNorms(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /** λ_h is the one of @p action. */
+    /** With @p lambda_h the λ_h of @p action (DiscreteAction::lambda_h()). */
     Errors
     compute(const DoFHandler<dim>     &dof_handler,
             const VectorType          &ghosted_solution,
             const DiscreteAction<dim> &action,
+            const VectorType          &lambda_h,
             const MPI_Comm             mpi_communicator) const;
 
   private:

@@ -44,18 +44,19 @@ namespace membranes
                 const MPI_Comm             mpi_communicator);
 
     /**
-     * Write what the scene asks for of cycle @p cycle. @p contact_fields has
-     * the layout of the solution and holds λ_a in the u1 slot and the active
-     * set indicator (1 or 0) in the u2 slot of every vertex; all vectors are
-     * ghosted. The error indicators η_K (one per active cell) are written to
-     * VTU when given. Returns the names of the files written, relative to
-     * the output directory: solution-NN.vtu (or .pvtu), nodal-values-NN.csv.
+     * Write what the scene asks for of cycle @p cycle. @p
+     * lambda_and_active_flags has the layout of the solution and holds λ_a in
+     * the u1 slot and the active set indicator (1 or 0) in the u2 slot of every
+     * vertex; all vectors are ghosted. The error indicators η_K (one per active
+     * cell) are written to VTU when given. Returns the names of the files
+     * written, relative to the output directory: solution-NN.vtu (or .pvtu),
+     * nodal-values-NN.csv.
      */
     std::vector<std::string>
     write(const unsigned int     cycle,
           const DoFHandler<dim> &dof_handler,
           const VectorType      &ghosted_solution,
-          const VectorType      &contact_fields,
+          const VectorType      &lambda_and_active_flags,
           const Vector<double>  *indicators);
 
     /**
@@ -93,7 +94,7 @@ namespace membranes
     write_vtu(const unsigned int     cycle,
               const DoFHandler<dim> &dof_handler,
               const VectorType      &ghosted_solution,
-              const VectorType      &contact_fields,
+              const VectorType      &lambda_and_active_flags,
               const Vector<double>  *indicators);
 
     /**
@@ -104,7 +105,7 @@ namespace membranes
     write_nodal_values(const unsigned int     cycle,
                        const DoFHandler<dim> &dof_handler,
                        const VectorType      &ghosted_solution,
-                       const VectorType      &contact_fields) const;
+                       const VectorType      &lambda_and_active_flags) const;
 
     const Parameters::Output                   &parameters;
     const Discretization<dim>                  &discretization;

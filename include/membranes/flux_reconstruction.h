@@ -203,18 +203,20 @@ namespace membranes
       double balance_defect = 0;
     };
 
-    /** The reconstruction of the λ_h held by @p action. */
+    /** The reconstruction for the discrete action @p action. */
     FluxReconstruction(const Discretization<dim> &discretization,
                        const ProblemData<dim>    &data,
                        const DiscreteAction<dim> &action);
 
     /**
-     * Compute t_1h, t_2h and σ_1h, σ_2h for @p ghosted_solution on the
-     * locally owned cells of @p dof_handler.
+     * Compute t_1h, t_2h and σ_1h, σ_2h for @p ghosted_solution and its
+     * @p lambda_h (DiscreteAction::lambda_h()) on the locally owned cells of
+     * @p dof_handler.
      */
     void
     reconstruct(const DoFHandler<dim>           &dof_handler,
                 const VectorType                &ghosted_solution,
+                const VectorType                &lambda_h,
                 const AffineConstraints<double> &hanging_node_constraints,
                 const IndexSet                  &locally_owned_dofs,
                 const MPI_Comm                   mpi_communicator);
@@ -255,7 +257,7 @@ namespace membranes
      * div t_ih.
      */
     std::vector<DataOutBase::Patch<dim, dim>>
-    patches() const;
+    patches(const VectorType &lambda_h) const;
 
     /** The names of the data of patches(), in order. */
     static std::vector<std::string>
@@ -451,6 +453,7 @@ namespace membranes
      */
     void
     equilibrate(const AlignedVector<PatchTerms> &patch_terms,
+                const VectorType                &lambda_h,
                 const AffineConstraints<double> &hanging_node_constraints,
                 const IndexSet                  &locally_owned_dofs,
                 const MPI_Comm                   mpi_communicator);
@@ -482,6 +485,7 @@ namespace membranes
     void
     solve_patches(const std::vector<PatchMember>  &local_members,
                   const AlignedVector<PatchTerms> &patch_terms,
+                  const VectorType                &lambda_h,
                   RemotePatches                   &remote);
 
     /**
@@ -493,6 +497,7 @@ namespace membranes
                 const unsigned int               end,
                 const std::vector<PatchMember>  &local_members,
                 const AlignedVector<PatchTerms> &patch_terms,
+                const VectorType                &lambda_h,
                 RemotePatches                   &remote,
                 PatchScratch                    &scratch,
                 PatchCopy                       &copy) const;

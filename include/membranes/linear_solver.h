@@ -1,7 +1,10 @@
 #ifndef membranes_linear_solver_h
 #define membranes_linear_solver_h
 
+#include <algorithm>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -15,7 +18,7 @@ namespace membranes
 
   /**
    * The linear solves inside the active set method: the condensed,
-   * symmetric positive definite system of one iteration.
+   * symmetric positive definite systems of one iteration.
    *
    * - `direct`: the sparse LU factorization of Trilinos Amesos
    *   (TrilinosWrappers::SolverDirect with direct_solver_package) of the
@@ -31,17 +34,10 @@ namespace membranes
    * rows of constrained boundary DoFs can dwarf the interior ones on fine
    * meshes), and starts from the vector it is given (the previous active set
    * iterate, or the interpolated solution of the previous mesh), so later
-   * iterations of the active set method are cheap.
-   *
-   * The AMG hierarchy is built for each solve, or, if the caller gives a
-   * mesh matrix, once per mesh from that matrix, which the caller keeps
-   * unchanged until the next reinit() (the hierarchy refers to it). The
-   * obstacle problem for w is such a case: its matrices differ from the
-   * operator of the mesh only in the eliminated rows and columns of the
-   * active vertices, so one hierarchy preconditions all of them. While the
-   * CG iterations of a solve stay within twice those of the solve that
-   * built the hierarchy (plus rebuild_slack), it is kept; a solve that
-   * needs more has it rebuilt for the next one.
+   * iterations of the active set method are cheap. It runs on any operator
+   * with a vmult(): a matrix, or the matrix seen through RestrictedOperator
+   * or ScaledOperator, with the AMG hierarchy of initialize_preconditioner()
+   * seen the same way.
    */
   template <int dim>
   class LinearSolver
@@ -61,9 +57,6 @@ namespace membranes
     /** Largest problem that `auto` hands to the direct solver. */
     static constexpr types::global_dof_index direct_solver_dof_limit = 10000;
 
-    /** CG iterations a reused hierarchy may need beyond twice its first. */
-    static constexpr unsigned int rebuild_slack = 5;
-
     LinearSolver(const Parameters::LinearSolverType type,
                  const MPI_Comm                     mpi_communicator);
 
@@ -71,26 +64,55 @@ namespace membranes
     void
     reinit(const DoFHandler<dim> &dof_handler);
 
-    /**
-     * Solve `matrix x = rhs`, starting from @p x, to a residual norm of at
-     * most @p tolerance (CG; but never below 1e-14 ‖rhs‖), preconditioned
-     * by the AMG hierarchy of @p mesh_matrix if given, of @p matrix
-     * otherwise. Returns the number of CG iterations (0 for the direct
-     * solver).
-     */
-    unsigned int
-    solve(const MatrixType &matrix,
-          VectorType       &x,
-          const VectorType &rhs,
-          const double      tolerance,
-          const MatrixType *mesh_matrix);
+    /** Whether reinit() chose the direct solver. */
+    bool
+    is_direct() const;
 
     /**
-     * Whether the AMG hierarchy of the last mesh matrix given to solve() is
-     * kept for the next solve (always false for the direct solver).
+     * Build the AMG hierarchy of @p matrix, kept (and referring to
+     * @p matrix) until the next reinit() or clear().
      */
+    void
+    initialize_preconditioner(const MatrixType &matrix);
+
+    /** Whether initialize_preconditioner() has built a hierarchy. */
     bool
-    has_mesh_preconditioner() const;
+    has_preconditioner() const;
+
+    /** The AMG hierarchy of initialize_preconditioner(). */
+    const TrilinosWrappers::PreconditionAMG &
+    preconditioner() const;
+
+    /** Solve `matrix x = rhs` by the LU factorization of @p matrix. */
+    void
+    solve_direct(const MatrixType &matrix,
+                 VectorType       &x,
+                 const VectorType &rhs) const;
+
+    /**
+     * Solve `op x = rhs` by CG preconditioned by @p preconditioner, starting
+     * from @p x, to a residual norm of at most @p tolerance (but never below
+     * 1e-14 ‖rhs‖). Returns the number of CG iterations.
+     */
+    template <typename OperatorType, typename PreconditionerType>
+    unsigned int
+    solve_cg(const OperatorType       &op,
+             const PreconditionerType &preconditioner,
+             VectorType               &x,
+             const VectorType         &rhs,
+             const double              tolerance) const
+    {
+      const double rhs_norm = rhs.l2_norm();
+      if (rhs_norm == 0)
+        {
+          x = 0;
+          return 0;
+        }
+      SolverControl control(10000, std::max(tolerance, 1e-14 * rhs_norm));
+      SolverCG<VectorType> cg(control);
+      cg.solve(op, x, rhs, preconditioner);
+      return control.last_step();
+    }
 
     /** Free the AMG hierarchy, when the last solve of a mesh is done. */
     void
@@ -101,28 +123,98 @@ namespace membranes
     method() const;
 
   private:
-    void
-    solve_direct(const MatrixType &matrix,
-                 VectorType       &x,
-                 const VectorType &rhs);
-
-    unsigned int
-    solve_cg_amg(const MatrixType &matrix,
-                 VectorType       &x,
-                 const VectorType &rhs,
-                 const double      tolerance,
-                 const MatrixType *mesh_matrix);
-
     const Parameters::LinearSolverType type;
     const MPI_Comm                     mpi_communicator;
 
     bool                           use_direct;
     std::vector<std::vector<bool>> constant_modes;
 
-    /** The AMG hierarchy of the mesh matrix, if built. */
+    /** The AMG hierarchy, if built. */
     std::unique_ptr<TrilinosWrappers::PreconditionAMG> amg;
-    /** CG iterations of the solve that built it. */
-    unsigned int first_iterations;
+  };
+
+
+
+  /**
+   * The operator Π (c B) Π + (I − Π) of an operator B (a matrix, or its AMG
+   * hierarchy), where Π sets the entries at a set of locally owned
+   * positions to zero: B restricted to the other entries, the identity on
+   * these. With B = A and the positions of the active vertices it is the
+   * matrix of the obstacle problem of one active set iteration with its
+   * constraints W_a = 0 condensed (DecoupledSystem), applied without a
+   * matrix of its own; with B the AMG hierarchy of A and c = 1/μ̄ it is its
+   * preconditioner. A vector with zeros at the positions is mapped to one
+   * with zeros there, so CG started there stays there.
+   */
+  template <typename OperatorType>
+  class RestrictedOperator
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    RestrictedOperator(const OperatorType              &op,
+                       const double                     coefficient,
+                       const std::vector<unsigned int> &positions,
+                       const VectorType                &layout)
+      : op(op)
+      , coefficient(coefficient)
+      , positions(positions)
+      , restricted(layout)
+    {}
+
+    void
+    vmult(VectorType &dst, const VectorType &src) const
+    {
+      restricted = src;
+      for (const unsigned int p : positions)
+        restricted.begin()[p] = 0;
+      op.vmult(dst, restricted);
+      dst *= coefficient;
+      for (const unsigned int p : positions)
+        dst.begin()[p] = src.begin()[p];
+    }
+
+  private:
+    const OperatorType              &op;
+    const double                     coefficient;
+    const std::vector<unsigned int> &positions;
+    mutable VectorType               restricted;
+  };
+
+
+
+  /**
+   * The operator D B D of an operator B and a diagonal D (a vector of the
+   * locally owned entries): the symmetric scaling of a system K x = b to
+   * D K D y = D b, x = D y, whose residual D(b − K x) is the one measured
+   * (CoupledSystem); with B the AMG hierarchy of K and D⁻¹ it is the
+   * preconditioner of the scaled system.
+   */
+  template <typename OperatorType>
+  class ScaledOperator
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    ScaledOperator(const OperatorType &op, const VectorType &scaling)
+      : op(op)
+      , scaling(scaling)
+      , scaled(scaling)
+    {}
+
+    void
+    vmult(VectorType &dst, const VectorType &src) const
+    {
+      scaled = src;
+      scaled.scale(scaling);
+      op.vmult(dst, scaled);
+      dst.scale(scaling);
+    }
+
+  private:
+    const OperatorType &op;
+    const VectorType   &scaling;
+    mutable VectorType  scaled;
   };
 } // namespace membranes
 

@@ -12,12 +12,9 @@
 #include <membranes/active_set.h>
 #include <membranes/active_set_solver.h>
 #include <membranes/discrete_action.h>
+#include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
-#include <membranes/error_estimator.h>
-#include <membranes/error_norms.h>
 #include <membranes/field_output.h>
-#include <membranes/flux_reconstruction.h>
-#include <membranes/mesh_operator.h>
 #include <membranes/output_directory.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
@@ -39,9 +36,9 @@ namespace membranes
    * refine the last mesh (globally, or by the estimator's indicators), set
    * up DoFs and constraints, transfer the previous solution and active set to
    * the new mesh (nested iteration), solve, postprocess (λ_h, the discrete
-   * identities), the errors against the exact solution, reconstruct the
-   * fluxes t_ih (if the scene asks for them), estimate the error, add a row
-   * to the report, write fields.
+   * identities), the errors against the exact solution, the residual
+   * estimator, the fluxes t_ih and σ_ih with the flux estimator (if the
+   * scene asks for them), add a row to the report, write fields.
    *
    * Data layout is that of deal.II's step-40: a distributed triangulation
    * (make_triangulation(): p4est for quadrilaterals, a shared triangulation
@@ -54,6 +51,11 @@ namespace membranes
    * process. One process is the case N = 1 of the same code.
    */
   template <int dim>
+  class FluxReconstruction;
+
+
+
+  template <int dim>
   class MembraneProblem
   {
   public:
@@ -63,6 +65,8 @@ namespace membranes
      */
     MembraneProblem(const Parameters::All &parameters,
                     const Provenance      &provenance);
+
+    ~MembraneProblem();
 
     void
     run();
@@ -83,8 +87,6 @@ namespace membranes
     void
     solve();
     void
-    compute_lambda_h();
-    void
     postprocess();
     void
     compute_errors();
@@ -94,8 +96,6 @@ namespace membranes
     reconstruct_fluxes();
     void
     estimate_error();
-    VectorType
-    contact_fields() const;
     std::string
     write_unconverged_iterate();
     void
@@ -121,10 +121,12 @@ namespace membranes
     Discretization<dim> discretization;
 
     const std::unique_ptr<Triangulation<dim>> triangulation;
-    DoFHandler<dim>                           dof_handler;
-    IndexSet                                  locally_owned_dofs;
-    IndexSet                                  locally_relevant_dofs;
-    AffineConstraints<double>                 hanging_node_constraints;
+    /** (u1, u2) on the FESystem, and the scalar element of each. */
+    DoFHandler<dim>           dof_handler;
+    DoFHandler<dim>           scalar_dof_handler;
+    IndexSet                  locally_owned_dofs;
+    IndexSet                  locally_relevant_dofs;
+    AffineConstraints<double> hanging_node_constraints;
 
     /** (u1h, u2h): locally owned entries, and a ghosted copy for reading. */
     VectorType solution;
@@ -132,19 +134,18 @@ namespace membranes
     /** λ_a in both DoF slots of every vertex a of V_h (ghosted). */
     VectorType lambda_h;
     /** Laplacian, loads, d_a and V_h of the current mesh. */
-    MeshOperator<dim> mesh_operator;
+    DiscreteProblem<dim> discrete_problem;
     /** The active vertices. */
     ActiveSet<dim> active_set;
     /** η_K² of the estimator that drives refinement, by active cell index. */
     Vector<double> indicators;
 
-    DiscreteAction<dim>     action;
-    ActiveSetSolver<dim>    active_set_solver;
-    ErrorNorms<dim>         error_norms;
-    FluxReconstruction<dim> flux_reconstruction;
-    ErrorEstimator<dim>     error_estimator;
-    Report                  report;
-    FieldOutput<dim>        field_output;
+    DiscreteAction<dim>  action;
+    ActiveSetSolver<dim> active_set_solver;
+    /** t_ih and σ_ih, only when the scene asks for fluxes. */
+    std::unique_ptr<FluxReconstruction<dim>> flux_reconstruction;
+    Report                                   report;
+    FieldOutput<dim>                         field_output;
     /** Held from the start of the first cycle to the end of the run. */
     OutputDirectory output_directory;
 

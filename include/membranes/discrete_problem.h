@@ -1,0 +1,243 @@
+#ifndef membranes_discrete_problem_h
+#define membranes_discrete_problem_h
+
+#include <array>
+#include <deal.II/base/function.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/mapping.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/discretization.h>
+#include <membranes/problem_data.h>
+#include <utility>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * @p hanging_node_constraints (closed) of @p dof_handler and
+   * @p boundary_values, interpolated at its boundary DoFs on all of ∂ω with
+   * @p mapping, into @p constraints (closed): what is constrained on every
+   * iteration of a mesh. A hanging vertex on ∂ω keeps its hanging node
+   * constraint.
+   */
+  template <int dim>
+  void
+  make_mesh_constraints(
+    const Mapping<dim>              &mapping,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const Function<dim>             &boundary_values,
+    AffineConstraints<double>       &constraints);
+
+
+
+  /**
+   * The discrete problem (3.4) on one mesh without its contact condition:
+   * the Laplacian and the loads of the two membranes on the scalar P1/Q1
+   * space, and the dual cells of the interior vertices. It is built once per
+   * mesh (MembraneProblem::setup_system()) and read, through a const
+   * reference, by everything that works on the mesh: DiscreteAction (the
+   * postprocessing (4.5)), the linear systems of the active set method
+   * (CoupledSystem, DecoupledSystem) and the ActiveSet. It holds no
+   * reference to the DoFHandlers it was built on; what needs one gets it
+   * from its owner, MembraneProblem.
+   *
+   * Both membranes live on one mesh with the same scalar element, so their
+   * Laplacians are one matrix A and the operator of membrane i is μ_i A.
+   * The DoFs of (u1, u2) in the FESystem are numbered vertex by vertex
+   * (those of scalar DoF k are 2k and 2k + 1), which reinit() checks; a
+   * vector of the FESystem and two scalar vectors hold the same numbers.
+   *
+   * It holds
+   * - A = (∫ ∇φ_a·∇φ_b), condensed by AffineConstraints with the hanging
+   *   node constraints and the boundary values: the rows and columns of
+   *   constrained DoFs eliminated, Σ_K A_K(j, j) on their diagonal. This is
+   *   the matrix of the linear problems of DecoupledSystem and the one
+   *   AMG hierarchy of the mesh is built from it;
+   * - the loads F_i = (∫ f_i φ_a), condensed with the hanging node
+   *   constraints, and the lifted loads F_i − μ_i A_{·,∂} g_i, condensed
+   *   like A with the boundary values g_1 = g, g_2 = g2: the right-hand
+   *   sides of membrane i. Their difference is the boundary column part of
+   *   μ_i A U_i, so that μ_i (A U_i)_a with the columns of ∂ω is
+   *   stiffness_term() without a second matrix;
+   * - the cell loads F_1K, F_2K (and the mean and oscillation of each load
+   *   on K) in the layout of CellSystem::copy_loads(), so that no system
+   *   evaluates the data again on this mesh;
+   * - the set V_h of the unconstrained interior vertices with, for each
+   *   locally owned one, d_a = ∫ φ_a (the lumped mass of (4.17); with
+   *   hanging nodes the row sum of the constrained mass matrix), ∫|∇φ_a|²
+   *   and the l1 norm of its row of A.
+   */
+  template <int dim>
+  class DiscreteProblem
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
+    struct Vertex
+    {
+      /** DoF of u1 (index 0) and of u2 (index 1) at a. */
+      std::array<types::global_dof_index, 2> dof;
+      /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
+      double dual_cell_measure;
+      /**
+       * Σ_K A_K(a, a) = ∫ |∇φ_a|² for the hat function of a without the
+       * shares of the hanging vertices it constrains: the scale of the
+       * stiffness matrix at a.
+       */
+      double stiffness_diagonal;
+      /**
+       * Σ_b |A_ab|, the l1 norm of the row of a in A (condensed with the
+       * hanging node constraints and the boundary values): half of it is
+       * the divisor of the projected Jacobi sweeps of ActiveSet.
+       */
+      double stiffness_row_l1_norm;
+    };
+
+    DiscreteProblem(const Discretization<dim> &discretization,
+                    const ProblemData<dim>    &data);
+
+    /**
+     * Assemble A, the loads and d_a on the mesh of @p dof_handler (the
+     * FESystem of (u1, u2), with its hanging node constraints
+     * @p hanging_node_constraints) and @p scalar_dof_handler (its base
+     * element on the same mesh), and find V_h.
+     */
+    void
+    reinit(const DoFHandler<dim>           &dof_handler,
+           const AffineConstraints<double> &hanging_node_constraints,
+           const DoFHandler<dim>           &scalar_dof_handler,
+           const MPI_Comm                   mpi_communicator);
+
+    /**
+     * The hanging node constraints of @p scalar_dof_handler and the boundary
+     * values c1 g + c2 g2 on all of ∂ω, into @p constraints (closed): those
+     * of u1 (1, 0), u2 (0, 1) and of their combinations s and w.
+     */
+    void
+    make_constraints(const DoFHandler<dim>     &scalar_dof_handler,
+                     const double               c1,
+                     const double               c2,
+                     AffineConstraints<double> &constraints) const;
+
+    MPI_Comm
+    get_mpi_communicator() const;
+    /** Index sets of the FESystem of (u1, u2). */
+    const IndexSet &
+    locally_owned_dofs() const;
+    const IndexSet &
+    locally_relevant_dofs() const;
+    /** Index sets of the scalar element. */
+    const IndexSet &
+    locally_owned_scalar_dofs() const;
+    const IndexSet &
+    locally_relevant_scalar_dofs() const;
+
+    /** A, condensed with the hanging node constraints and boundary values. */
+    const TrilinosWrappers::SparseMatrix &
+    laplace_matrix() const;
+
+    /** F_i, condensed with the hanging node constraints. */
+    const VectorType &
+    loads(const unsigned int i) const;
+
+    /** F_i − μ_i A_{·,∂} g_i, condensed as A (zero in constrained rows). */
+    const VectorType &
+    lifted_loads(const unsigned int i) const;
+
+    /** The loads F_1K, F_2K of the locally owned cell @p cell. */
+    const double *
+    cell_loads(
+      const typename DoFHandler<dim>::active_cell_iterator &cell) const;
+
+    /**
+     * The mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of load @p i on
+     * the locally owned cell @p cell.
+     */
+    std::pair<double, double>
+    load_mean_and_oscillation(
+      const typename DoFHandler<dim>::active_cell_iterator &cell,
+      const unsigned int                                    i) const;
+
+    /** The locally owned vertices of V_h, by increasing u1 DoF. */
+    const std::vector<Vertex> &
+    vertices() const;
+
+    /**
+     * The positions of the DoFs (u1, u2) of vertices() in the local storage
+     * of a vector of the locally owned DoFs of the FESystem (all such
+     * vectors share one layout): reading them there needs no search per
+     * entry. Half the position of the u1 DoF is that of the vertex in a
+     * scalar vector.
+     */
+    const std::vector<std::array<int, 2>> &
+    local_positions() const;
+
+    /**
+     * The DoFs (u1, u2) of the locally relevant vertices of V_h: those of
+     * the locally owned and ghost cells.
+     */
+    const std::vector<std::array<types::global_dof_index, 2>> &
+    locally_relevant_vertices() const;
+
+    /**
+     * Whether the u1 DoF @p a (locally relevant) belongs to an interior
+     * vertex, of V_h or hanging: the vertices whose dual cells make up ω_h.
+     */
+    bool
+    is_interior_vertex(const types::global_dof_index a) const;
+
+  private:
+    /**
+     * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
+     * condensed by distribute_local_to_global with its constraints.
+     */
+    void
+    assemble(const DoFHandler<dim> &dof_handler,
+             VectorType            &dual_cell_measure,
+             VectorType            &stiffness_diagonal);
+
+    /** V_h and its data, from the vectors that assemble() fills. */
+    void
+    find_vertices(const DoFHandler<dim>           &dof_handler,
+                  const AffineConstraints<double> &hanging_node_constraints,
+                  const VectorType                &dual_cell_measure,
+                  const VectorType                &stiffness_diagonal);
+
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
+
+    MPI_Comm mpi_communicator;
+    IndexSet owned_dofs, relevant_dofs;
+    IndexSet owned_scalar_dofs, relevant_scalar_dofs;
+
+    /** Hanging nodes and boundary values g_i of membrane i. */
+    std::array<AffineConstraints<double>, 2> membrane_constraints;
+    /** The hanging node constraints of the scalar element. */
+    AffineConstraints<double> scalar_hanging_node_constraints;
+
+    TrilinosWrappers::SparseMatrix matrix;
+    std::array<VectorType, 2>      load_vectors;
+    std::array<VectorType, 2>      lifted_load_vectors;
+    /**
+     * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
+     * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
+     * on (n_v hat functions per cell).
+     */
+    std::vector<double> loads_of_cells;
+    unsigned int        loads_per_cell;
+
+    std::vector<Vertex>                                 interior_vertices;
+    std::vector<std::array<int, 2>>                     positions;
+    std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
+    IndexSet                                            interior_vertex_dofs;
+  };
+} // namespace membranes
+
+#endif
