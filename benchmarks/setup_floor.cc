@@ -25,9 +25,9 @@
  * touch fresh pages instead of reusing freed ones, which costs time, so
  * the times are read without it.
  *
- * The matrix couples the DoFs of a cell in the way of membranes'
- * MeshOperator, each component only with itself (`components`, the
- * default: the least that the active set method needs on a mesh), or in
+ * The matrix couples the DoFs of a cell each component only with itself
+ * (`components`, the default: two scalar Laplacians, twice the one matrix
+ * of membranes' DiscreteProblem), or in
  * the way of its CoupledSystem, every DoF with every other (`full`: the
  * matrix that the yardstick of solver_cost.sh solves with, whose u1–u2
  * entries stay zero without contact).

@@ -61,9 +61,12 @@ namespace membranes
     // the terms of the obstacle problem for w, whose combination
     // (μ2 · membrane 1 + μ1 · membrane 2)/(μ1 + μ2) carries the rounding
     // error of forces of tension μ̄.
+    // In the same pass, λ_a of both formulas, which the active set method
+    // reads many times per iteration.
     const auto  &vertices = problem->vertices();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
+    membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const Vertex               &a = vertices[k];
@@ -71,6 +74,10 @@ namespace membranes
           {stiffness_term(0, k), stiffness_term(1, k)}};
         const std::array<double, 2> loads{{load_term(0, k), load_term(1, k)}};
         const auto                 &position = problem->local_positions()[k];
+        for (unsigned int i = 0; i < 2; ++i)
+          membrane_lambdas[k][i] = (i == 0 ? 1. : -1.) *
+                                   (stiffness[i] - loads[i]) /
+                                   a.dual_cell_measure;
         for (unsigned int i = 0; i < 2; ++i)
           local_max = std::max({local_max,
                                 std::abs(stiffness[i]),
@@ -139,9 +146,7 @@ namespace membranes
   DiscreteAction<dim>::lambda_from_membrane(const unsigned int i,
                                             const unsigned int k) const
   {
-    const double sign = (i == 0 ? 1. : -1.);
-    return sign * (stiffness_term(i, k) - load_term(i, k)) /
-           vertices()[k].dual_cell_measure;
+    return membrane_lambdas[k][i];
   }
 
 

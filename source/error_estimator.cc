@@ -6,7 +6,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <membranes/cell_loop.h>
 #include <membranes/error_estimator.h>
-#include <membranes/flux_reconstruction.h>
+#include <membranes/flux_equilibration.h>
 
 namespace membranes
 {
@@ -404,13 +404,13 @@ namespace membranes
   template <int dim>
   typename ErrorEstimator<dim>::FluxEstimate
   ErrorEstimator<dim>::flux_estimate(
-    const DoFHandler<dim>         &dof_handler,
-    const VectorType              &ghosted_solution,
-    const DiscreteAction<dim>     &action,
-    const VectorType              &lambda_h,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    Vector<double>                &indicators,
-    const MPI_Comm                 mpi_communicator) const
+    const DoFHandler<dim>        &dof_handler,
+    const VectorType             &ghosted_solution,
+    const DiscreteAction<dim>    &action,
+    const VectorType             &lambda_h,
+    const FluxEquilibration<dim> &flux_equilibration,
+    Vector<double>               &indicators,
+    const MPI_Comm                mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
     FluxTerms sums;
@@ -424,7 +424,7 @@ namespace membranes
         if (!cell->is_locally_owned())
           return;
         terms = flux_terms(
-          cell, ghosted_solution, action, flux_reconstruction, scratch);
+          cell, ghosted_solution, action, flux_equilibration, scratch);
         indicators[cell->active_cell_index()] = terms.eta_squared();
       },
       [&](const FluxTerms &terms) { sums += terms; });
@@ -452,11 +452,11 @@ namespace membranes
   template <int dim>
   typename ErrorEstimator<dim>::FluxTerms
   ErrorEstimator<dim>::flux_terms(
-    const CellIterator            &cell,
-    const VectorType              &ghosted_solution,
-    const DiscreteAction<dim>     &action,
-    const FluxReconstruction<dim> &flux_reconstruction,
-    FluxScratch                   &scratch) const
+    const CellIterator           &cell,
+    const VectorType             &ghosted_solution,
+    const DiscreteAction<dim>    &action,
+    const FluxEquilibration<dim> &flux_equilibration,
+    FluxScratch                  &scratch) const
   {
     scratch.values.reinit(cell, ghosted_solution);
     const FEValues<dim> &fe_values = scratch.values.fe_values;
@@ -473,9 +473,10 @@ namespace membranes
           scratch.values.local_dofs, scratch.u[i]);
         fe_values[membrane].get_function_gradients_from_local_dof_values(
           scratch.values.local_dofs, scratch.grad_u[i]);
-        flux_reconstruction.flux_values(
+        flux_equilibration.flux_values(
           cell, i, fe_values, scratch.flux, scratch.divergence);
-        const auto load = flux_reconstruction.load_values(cell, i);
+        const auto load =
+          flux_equilibration.get_reconstruction().load_values(cell, i);
         for (const unsigned int q : fe_values.quadrature_point_indices())
           {
             terms.flux[i] +=

@@ -1,10 +1,10 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
 #include <membranes/cell_loop.h>
-#include <membranes/flux_reconstruction.h>
+#include <membranes/flux_equilibration.h>
 
 // The patch equilibration σ_ih = Σ_a σ_ih^a (see the class comment of
-// FluxReconstruction): which cells belong to which patch, the records of
+// FluxEquilibration): which cells belong to which patch, the records of
 // their sub-triangles, their exchange between processes, and the patch
 // problems on threads. The patch problem itself is PatchProblem.
 
@@ -12,7 +12,7 @@ namespace membranes
 {
   /** The work arrays of one thread of solve_patches(). */
   template <int dim>
-  struct FluxReconstruction<dim>::PatchScratch
+  struct FluxEquilibration<dim>::PatchScratch
   {
     explicit PatchScratch(const unsigned int n_ring)
       : problem(n_ring)
@@ -32,7 +32,7 @@ namespace membranes
    * sub-triangle of the ring.
    */
   template <int dim>
-  struct FluxReconstruction<dim>::PatchCopy
+  struct FluxEquilibration<dim>::PatchCopy
   {
     unsigned int        first = 0, n_cells = 0;
     std::vector<double> results;
@@ -41,8 +41,61 @@ namespace membranes
 
 
   template <int dim>
+  FluxEquilibration<dim>::FluxEquilibration(
+    const FluxReconstruction<dim> &reconstruction,
+    const DiscreteAction<dim>     &action)
+    : reconstruction(reconstruction)
+    , action(action)
+    , basis(reconstruction.sub_triangle_basis())
+  {}
+
+
+
+  template <int dim>
+  const FluxReconstruction<dim> &
+  FluxEquilibration<dim>::get_reconstruction() const
+  {
+    return reconstruction;
+  }
+
+
+
+  template <int dim>
   void
-  FluxReconstruction<dim>::write_patch_record(
+  FluxEquilibration<dim>::flux_values(const CellIterator          &cell,
+                                      const unsigned int           i,
+                                      const FEValues<dim>         &fe_values,
+                                      std::vector<Tensor<1, dim>> &flux,
+                                      std::vector<double> &divergence) const
+  {
+    const DualCellQuadrature<dim> &dual_cell_quadrature =
+      action.dual_quadrature();
+    const auto        &quadrature  = dual_cell_quadrature.quadrature();
+    const auto        &triangles   = dual_cell_quadrature.sub_triangles();
+    const unsigned int n_triangles = triangles.size();
+    flux.resize(quadrature.size());
+    divergence.resize(quadrature.size());
+    for (unsigned int q = 0; q < quadrature.size(); ++q)
+      {
+        const unsigned int   s  = dual_cell_quadrature.sub_triangle_of_point(q);
+        const unsigned int   id = cell->active_cell_index() * n_triangles + s;
+        const auto          &f  = sigma[id][i];
+        const Tensor<2, dim> DF = jacobian_matrix(fe_values.jacobian(q));
+        const double         det = std::abs(determinant(DF));
+        Tensor<1, dim>       reference =
+          basis.reference_flux(s, f, quadrature.point(q));
+        for (unsigned int l = 0; l < 2; ++l)
+          reference += cell_rotations[id][i][l] * basis.rotation_basis(q)[l];
+        flux[q]       = DF * reference / det;
+        divergence[q] = (f[0] + f[1] + f[2]) / (triangles[s].area * det);
+      }
+  }
+
+
+
+  template <int dim>
+  void
+  FluxEquilibration<dim>::write_patch_record(
     const CellIterator              &cell,
     const types::global_dof_index    a,
     const HatCoefficients           &coefficients,
@@ -56,8 +109,8 @@ namespace membranes
       {
         const unsigned int id =
           cell->active_cell_index() * n_triangles + ring[j];
-        const SubTriangleData &kappa = sub_triangle_data[id];
-        const PatchTerms      &terms = patch_terms[id];
+        const auto       &kappa = reconstruction.sub_triangles()[id];
+        const PatchTerms &terms = patch_terms[id];
 
         record->vertex      = a;
         record->key         = terms.key;
@@ -100,7 +153,7 @@ namespace membranes
 
   template <int dim>
   void
-  FluxReconstruction<dim>::equilibrate(
+  FluxEquilibration<dim>::equilibrate(
     const AlignedVector<PatchTerms> &patch_terms,
     const VectorType                &lambda_h,
     const AffineConstraints<double> &hanging_node_constraints,
@@ -124,8 +177,9 @@ namespace membranes
                                               locally_owned_dofs,
                                               mpi_communicator);
 
-    for (auto &kappa : sub_triangle_data)
-      kappa.equilibrated = {};
+    const unsigned int n_sub_triangles = reconstruction.sub_triangles().size();
+    sigma.assign(n_sub_triangles, Fluxes{});
+    cell_rotations.assign(n_sub_triangles, {});
     solve_patches(local_members, patch_terms, lambda_h, remote);
     for (const auto &[process, buffer] :
          Utilities::MPI::some_to_some(mpi_communicator, remote.replies))
@@ -139,17 +193,18 @@ namespace membranes
 
 
   template <int dim>
-  std::vector<typename FluxReconstruction<dim>::PatchMember>
-  FluxReconstruction<dim>::patch_members(
+  std::vector<typename FluxEquilibration<dim>::PatchMember>
+  FluxEquilibration<dim>::patch_members(
     const AffineConstraints<double> &hanging_node_constraints) const
   {
     std::vector<PatchMember> members;
-    members.reserve(dof_handler->get_triangulation().n_active_cells() *
+    const DoFHandler<dim>   &dof_handler = reconstruction.get_dof_handler();
+    members.reserve(dof_handler.get_triangulation().n_active_cells() *
                     GeometryInfo<dim>::vertices_per_cell);
     // The condensed hat functions of one cell, by increasing a: at most two
     // parents for each vertex.
     std::vector<std::pair<types::global_dof_index, HatCoefficients>> of_cell;
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           of_cell.clear();
@@ -188,8 +243,8 @@ namespace membranes
 
 
   template <int dim>
-  typename FluxReconstruction<dim>::RemotePatches
-  FluxReconstruction<dim>::send_patch_records(
+  typename FluxEquilibration<dim>::RemotePatches
+  FluxEquilibration<dim>::send_patch_records(
     const std::vector<PatchMember>  &remote_members,
     const AlignedVector<PatchTerms> &patch_terms,
     const IndexSet                  &locally_owned_dofs,
@@ -237,7 +292,7 @@ namespace membranes
 
   template <int dim>
   void
-  FluxReconstruction<dim>::solve_patches(
+  FluxEquilibration<dim>::solve_patches(
     const std::vector<PatchMember>  &local_members,
     const AlignedVector<PatchTerms> &patch_terms,
     const VectorType                &lambda_h,
@@ -279,7 +334,7 @@ namespace membranes
 
   template <int dim>
   void
-  FluxReconstruction<dim>::solve_patch(
+  FluxEquilibration<dim>::solve_patch(
     const unsigned int               first,
     const unsigned int               end,
     const std::vector<PatchMember>  &local_members,
@@ -328,24 +383,19 @@ namespace membranes
 
   template <int dim>
   void
-  FluxReconstruction<dim>::add_patch_result(const CellIterator &cell,
-                                            const double       *result)
+  FluxEquilibration<dim>::add_patch_result(const CellIterator &cell,
+                                           const double       *result)
   {
     const auto        &ring        = basis.ring();
     const unsigned int n_triangles = basis.n_sub_triangles();
     for (unsigned int j = 0; j < ring.size(); ++j)
       for (unsigned int i = 0; i < 2; ++i)
         for (unsigned int e = 0; e < 3; ++e)
-          sub_triangle_data[cell->active_cell_index() * n_triangles + ring[j]]
-            .equilibrated[i][e] += result[6 * j + 3 * i + e];
+          sigma[cell->active_cell_index() * n_triangles + ring[j]][i][e] +=
+            result[6 * j + 3 * i + e];
   }
 
 
 
-  template void
-  FluxReconstruction<2>::equilibrate(const AlignedVector<PatchTerms> &,
-                                     const VectorType &,
-                                     const AffineConstraints<double> &,
-                                     const IndexSet &,
-                                     const MPI_Comm);
+  template class FluxEquilibration<2>;
 } // namespace membranes

@@ -6,7 +6,7 @@
 #include <tuple>
 
 // The patch problems of the equilibration of σ_ih (see the class comment of
-// FluxReconstruction and PatchProblem).
+// FluxEquilibration and PatchProblem).
 
 namespace membranes
 {

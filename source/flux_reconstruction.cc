@@ -7,9 +7,7 @@
 #include <type_traits>
 
 // The fluxes t_ih of (4.13) and the identities (4.17), (4.18) and Lemma 17,
-// the evaluation of σ_ih, and the dual mesh as output; the patch
-// equilibration of σ_ih is in flux_equilibration.cc, its rotations in
-// flux_rotations.cc.
+// and the dual mesh as output.
 
 namespace membranes
 {
@@ -146,14 +144,9 @@ namespace membranes
 
 
   template <int dim>
-  void
-  FluxReconstruction<dim>::reconstruct(
-    const DoFHandler<dim>           &dof_handler,
-    const VectorType                &ghosted_solution,
-    const VectorType                &lambda_h,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const IndexSet                  &locally_owned_dofs,
-    const MPI_Comm                   mpi_communicator)
+  AlignedVector<typename FluxReconstruction<dim>::PatchTerms>
+  FluxReconstruction<dim>::reconstruct(const DoFHandler<dim> &dof_handler,
+                                       const VectorType      &ghosted_solution)
   {
     this->dof_handler = &dof_handler;
     const unsigned int n_cells =
@@ -172,11 +165,7 @@ namespace membranes
     hat_integrals.assign(n_cells, {});
 
     set_half_edge_fluxes(compute_local_fluxes(ghosted_solution, patch_terms));
-    equilibrate(patch_terms,
-                lambda_h,
-                hanging_node_constraints,
-                locally_owned_dofs,
-                mpi_communicator);
+    return patch_terms;
   }
 
 
@@ -282,7 +271,7 @@ namespace membranes
   /**
    * The fluxes (4.13) through the edges 0 and 1, by Gauss points on the
    * reference edges: n ds = cof(DF) n̂ dŝ. On the owned cells, the hat
-   * function terms of the patch problems (see equilibrate()): the fluxes of
+   * function terms of the patch problems (see FluxEquilibration): the fluxes of
    * φ_v μ_i ∇u_ih through all three edges of κ, and ∫ φ_v along a half-edge
    * on ∂ω.
    */
@@ -657,38 +646,6 @@ namespace membranes
 
 
   template <int dim>
-  void
-  FluxReconstruction<dim>::flux_values(const CellIterator          &cell,
-                                       const unsigned int           i,
-                                       const FEValues<dim>         &fe_values,
-                                       std::vector<Tensor<1, dim>> &flux,
-                                       std::vector<double> &divergence) const
-  {
-    const auto        &quadrature  = dual_cell_quadrature.quadrature();
-    const auto        &triangles   = dual_cell_quadrature.sub_triangles();
-    const unsigned int n_triangles = triangles.size();
-    flux.resize(quadrature.size());
-    divergence.resize(quadrature.size());
-    for (unsigned int q = 0; q < quadrature.size(); ++q)
-      {
-        const unsigned int s = dual_cell_quadrature.sub_triangle_of_point(q);
-        const SubTriangleData &kappa =
-          sub_triangle_data[cell->active_cell_index() * n_triangles + s];
-        const auto          &f   = kappa.equilibrated[i];
-        const Tensor<2, dim> DF  = jacobian_matrix(fe_values.jacobian(q));
-        const double         det = std::abs(determinant(DF));
-        Tensor<1, dim>       reference =
-          basis.reference_flux(s, f, quadrature.point(q));
-        for (unsigned int l = 0; l < 2; ++l)
-          reference += kappa.rotations[i][l] * basis.rotation_basis(q)[l];
-        flux[q]       = DF * reference / det;
-        divergence[q] = (f[0] + f[1] + f[2]) / (triangles[s].area * det);
-      }
-  }
-
-
-
-  template <int dim>
   ArrayView<const double>
   FluxReconstruction<dim>::load_values(const CellIterator &cell,
                                        const unsigned int  i) const
@@ -769,6 +726,33 @@ namespace membranes
             }
         }
     return patches;
+  }
+
+
+
+  template <int dim>
+  const DoFHandler<dim> &
+  FluxReconstruction<dim>::get_dof_handler() const
+  {
+    return *dof_handler;
+  }
+
+
+
+  template <int dim>
+  const SubTriangleBasis<dim> &
+  FluxReconstruction<dim>::sub_triangle_basis() const
+  {
+    return basis;
+  }
+
+
+
+  template <int dim>
+  const AlignedVector<typename FluxReconstruction<dim>::SubTriangleData> &
+  FluxReconstruction<dim>::sub_triangles() const
+  {
+    return sub_triangle_data;
   }
 
 

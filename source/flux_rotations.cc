@@ -2,20 +2,17 @@
 #include <deal.II/base/parallel.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
-#include <membranes/flux_reconstruction.h>
+#include <membranes/flux_equilibration.h>
 #include <membranes/ghost_cell_exchange.h>
 
 // The rotation relaxation of the equilibrated fluxes σ_ih: divergence-free
 // corrections around the vertices of the sub-mesh S_h and inside each cell
-// (see the class comment of FluxReconstruction).
+// (see the class comment of FluxEquilibration).
 
 namespace membranes
 {
   namespace
   {
-    /** The outward fluxes of σ_ih through the edges of κ, per i. */
-    using Fluxes = std::array<std::array<double, 3>, 2>;
-
     /**
      * A rotation around a vertex p of S_h on one sub-triangle κ: the index
      * of κ in the sub-triangle data, the change u_κ of its fluxes, and, for
@@ -171,7 +168,7 @@ namespace membranes
    * 2: b_K, 3: hanging vertex).
    */
   template <int dim>
-  struct FluxReconstruction<dim>::Rotations
+  struct FluxEquilibration<dim>::Rotations
   {
     std::vector<Rotation>                      rotations;
     std::array<std::vector<RotationVertex>, 4> vertices_of_kind;
@@ -205,20 +202,14 @@ namespace membranes
    */
   template <int dim>
   void
-  FluxReconstruction<dim>::relax_rotations()
+  FluxEquilibration<dim>::relax_rotations()
   {
     Rotations              rotations   = rotations_around_vertices();
     const unsigned int     n_triangles = basis.n_sub_triangles();
     GhostCellExchange<dim> ghost_cells;
-    ghost_cells.reinit(dof_handler->get_triangulation(),
-                       dof_handler->get_communicator());
-
-    // The sweeps work on a copy of the fluxes of σ_ih alone (in the order
-    // of sub_triangle_data), which the caches hold far better than
-    // sub_triangle_data itself.
-    std::vector<Fluxes> sigma(sub_triangle_data.size());
-    for (unsigned int id = 0; id < sigma.size(); ++id)
-      sigma[id] = sub_triangle_data[id].equilibrated;
+    const DoFHandler<dim> &dof_handler = reconstruction.get_dof_handler();
+    ghost_cells.reinit(dof_handler.get_triangulation(),
+                       dof_handler.get_communicator());
 
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
       for (const unsigned int kind : Rotations::sweep_order)
@@ -248,8 +239,6 @@ namespace membranes
                               }
                           });
         }
-    for (unsigned int id = 0; id < sigma.size(); ++id)
-      sub_triangle_data[id].equilibrated = sigma[id];
   }
 
 
@@ -269,26 +258,27 @@ namespace membranes
    * fluxes F_κ.
    */
   template <int dim>
-  typename FluxReconstruction<dim>::Rotations
-  FluxReconstruction<dim>::rotations_around_vertices() const
+  typename FluxEquilibration<dim>::Rotations
+  FluxEquilibration<dim>::rotations_around_vertices() const
   {
-    const auto        &triangles     = basis.sub_triangles();
-    const unsigned int n_triangles   = triangles.size();
-    const auto         order         = counterclockwise_corners(triangles);
-    const auto        &triangulation = dof_handler->get_triangulation();
-    const unsigned int n_vertices    = triangulation.n_vertices();
-    const unsigned int first_cell    = n_vertices + triangulation.n_raw_faces();
-    const unsigned int n_nodes = first_cell + triangulation.n_active_cells();
+    const DoFHandler<dim> &dof_handler   = reconstruction.get_dof_handler();
+    const auto            &triangles     = basis.sub_triangles();
+    const unsigned int     n_triangles   = triangles.size();
+    const auto             order         = counterclockwise_corners(triangles);
+    const auto            &triangulation = dof_handler.get_triangulation();
+    const unsigned int     n_vertices    = triangulation.n_vertices();
+    const unsigned int first_cell = n_vertices + triangulation.n_raw_faces();
+    const unsigned int n_nodes    = first_cell + triangulation.n_active_cells();
     std::vector<RotationEntry> entries;
     entries.reserve(triangulation.n_active_cells() * n_triangles * 3);
     std::vector<char> owned(n_nodes, 0), on_boundary(n_nodes, 0);
     std::vector<char> hanging(n_vertices, 0);
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         for (const unsigned int f : cell->face_indices())
           if (!cell->at_boundary(f) && cell->face(f)->has_children())
             hanging[cell->face(f)->child(0)->vertex_index(1)] = 1;
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
@@ -343,8 +333,8 @@ namespace membranes
       for_each_vertex(result.vertices_of_kind[kind], [&](RotationVertex &p) {
         for (unsigned int t = p.begin; t < p.end; ++t)
           {
-            Rotation              &rotation = result.rotations[t];
-            const SubTriangleData &kappa    = sub_triangle_data[rotation.kappa];
+            Rotation   &rotation = result.rotations[t];
+            const auto &kappa = reconstruction.sub_triangles()[rotation.kappa];
             for (unsigned int k = 0; k < 3; ++k)
               {
                 rotation.Gu[k] = 0;
@@ -388,12 +378,13 @@ namespace membranes
    */
   template <int dim>
   void
-  FluxReconstruction<dim>::relax_cell_rotations()
+  FluxEquilibration<dim>::relax_cell_rotations()
   {
-    const auto        &triangles   = basis.sub_triangles();
-    const unsigned int n_triangles = triangles.size();
-    const unsigned int n_vertices =
-      dof_handler->get_fe().reference_cell().n_vertices();
+    const auto            &triangles   = basis.sub_triangles();
+    const unsigned int     n_triangles = triangles.size();
+    const DoFHandler<dim> &dof_handler = reconstruction.get_dof_handler();
+    const unsigned int     n_vertices =
+      dof_handler.get_fe().reference_cell().n_vertices();
     // The bubble of edge 0 of κ (from m_e to b_K) is unknown n_vertices + e,
     // that of edge 1 (from a to b_K) unknown a.
     const auto unknown = [&](const unsigned int s, const unsigned int l) {
@@ -406,12 +397,12 @@ namespace membranes
         right_hand_side[i].reinit(2 * n_vertices);
         coefficients[i].reinit(2 * n_vertices);
       }
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          SubTriangleData *kappa =
-            sub_triangle_data.data() + cell->active_cell_index() * n_triangles;
-          bubble_gram = 0;
+          const unsigned int first = cell->active_cell_index() * n_triangles;
+          const auto *const  kappa = &reconstruction.sub_triangles()[first];
+          bubble_gram              = 0;
           for (unsigned int i = 0; i < 2; ++i)
             right_hand_side[i] = 0;
           for (unsigned int s = 0; s < n_triangles; ++s)
@@ -425,7 +416,7 @@ namespace membranes
                     double residual = kappa[s].discrete_rotation[i][l];
                     for (unsigned int k = 0; k < 3; ++k)
                       residual +=
-                        kappa[s].mixed_gram[k][l] * kappa[s].equilibrated[i][k];
+                        kappa[s].mixed_gram[k][l] * sigma[first + s][i][k];
                     right_hand_side[i](unknown(s, l)) -= residual;
                   }
               }
@@ -435,7 +426,8 @@ namespace membranes
               bubble_gram.vmult(coefficients[i], right_hand_side[i]);
               for (unsigned int s = 0; s < n_triangles; ++s)
                 for (unsigned int l = 0; l < 2; ++l)
-                  kappa[s].rotations[i][l] = coefficients[i](unknown(s, l));
+                  cell_rotations[first + s][i][l] =
+                    coefficients[i](unknown(s, l));
             }
         }
   }
@@ -443,7 +435,7 @@ namespace membranes
 
 
   template void
-  FluxReconstruction<2>::relax_rotations();
+  FluxEquilibration<2>::relax_rotations();
   template void
-  FluxReconstruction<2>::relax_cell_rotations();
+  FluxEquilibration<2>::relax_cell_rotations();
 } // namespace membranes

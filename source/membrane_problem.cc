@@ -8,6 +8,7 @@
 #include <map>
 #include <membranes/error_estimator.h>
 #include <membranes/error_norms.h>
+#include <membranes/flux_equilibration.h>
 #include <membranes/flux_reconstruction.h>
 #include <membranes/membrane_problem.h>
 #include <unistd.h>
@@ -41,6 +42,11 @@ namespace membranes
           std::make_unique<FluxReconstruction<dim>>(discretization,
                                                     data,
                                                     action) :
+          nullptr)
+    , flux_equilibration(
+        computes_fluxes() ?
+          std::make_unique<FluxEquilibration<dim>>(*flux_reconstruction,
+                                                   action) :
           nullptr)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
@@ -430,12 +436,12 @@ namespace membranes
     if (!computes_fluxes())
       return;
     TimerOutput::Scope scope(computing_timer, "flux");
-    flux_reconstruction->reconstruct(dof_handler,
-                                     ghosted_solution,
-                                     lambda_h,
-                                     hanging_node_constraints,
-                                     locally_owned_dofs,
-                                     mpi_communicator);
+    flux_equilibration->equilibrate(
+      flux_reconstruction->reconstruct(dof_handler, ghosted_solution),
+      lambda_h,
+      hanging_node_constraints,
+      locally_owned_dofs,
+      mpi_communicator);
     if (parameters.output.flux_reconstruction)
       {
         const auto identities =
@@ -453,7 +459,7 @@ namespace membranes
                                            ghosted_solution,
                                            action,
                                            lambda_h,
-                                           *flux_reconstruction,
+                                           *flux_equilibration,
                                            flux_indicators,
                                            mpi_communicator);
     record.flux_estimator             = estimate.eta;

@@ -559,11 +559,7 @@ namespace
 
     // The dual cell D_a and div t_ih, from the sub-triangles of S_h.
     problem.flux_reconstruction.reconstruct(problem.dof_handler,
-                                            problem.ghosted_solution,
-                                            problem.lambda_h,
-                                            problem.constraints,
-                                            problem.owned_dofs,
-                                            problem.mpi_communicator);
+                                            problem.ghosted_solution);
     unsigned int a_vertex = numbers::invalid_unsigned_int;
     for (unsigned int v = 0; v < problem.triangulation->n_vertices(); ++v)
       if (problem.triangulation->get_vertices()[v].distance(

@@ -206,6 +206,9 @@ namespace membranes
      */
     std::array<VectorType, 2> membrane_values, stiffness_products;
 
+    /** λ_a from formula i of (4.5), by vertex, of the last compute(). */
+    std::vector<std::array<double, 2>> membrane_lambdas;
+
     double max_force;
     double max_contact_force;
   };

@@ -17,7 +17,7 @@ namespace membranes
   using namespace dealii;
 
   template <int dim>
-  class FluxReconstruction;
+  class FluxEquilibration;
 
   /**
    * The two a posteriori estimators of the contact problem, selected by
@@ -35,7 +35,7 @@ namespace membranes
    *
    * with s_1 = +1, s_2 = −1 (−μ_i Δu_i = f_i + s_i λ by (1.1)), f_ih the mean
    * of f_i on K (4.14), λ_h piecewise constant on the dual cells (integrated
-   * over the pieces K ∩ D_a with the FluxReconstruction's quadrature; zero in
+   * over the pieces K ∩ D_a with the dual-cell quadrature; zero in
    * the strip ω \ ω_h along the boundary), [·] the jump across interior edges
    * (on edges with a hanging node, across each of the two small edges).
    *
@@ -60,7 +60,7 @@ namespace membranes
    * with hanging nodes.
    *
    * <h3>The flux estimator</h3>
-   * Built on the equilibrated fluxes σ_ih of FluxReconstruction, on the
+   * Built on the equilibrated fluxes σ_ih of FluxEquilibration, on the
    * sub-mesh S_h of §4.2 (in the spirit of Part 2 of the paper and of
    * Dabaghi, Martin and Vohralík for this problem).
    *
@@ -89,7 +89,7 @@ namespace membranes
    * (Lemma 17, up to data oscillation): div t_ih varies from one
    * sub-triangle of D_a to the next by O(|∇²u|), which would make η_R as
    * large as η_F. The estimator therefore uses the equilibrated flux σ_ih
-   * of FluxReconstruction, the sum of patch contributions on the supports
+   * of FluxEquilibration, the sum of patch contributions on the supports
    * of the hat functions: div σ_ih = Π_0 (f_i + s_i λ̃_h) on every
    * sub-triangle of S_h, with λ̃_h = Σ_a λ_a φ_a the P1/Q1 function of the
    * nodal λ_a. The argument above holds with λ̃_h in place of λ_h (it only
@@ -156,16 +156,16 @@ namespace membranes
 
     /**
      * The flux estimator: the same with the equilibrated fluxes of
-     * @p flux_reconstruction and the nodal λ_a of @p lambda_h.
+     * @p flux_equilibration and the nodal λ_a of @p lambda_h.
      */
     FluxEstimate
-    flux_estimate(const DoFHandler<dim>         &dof_handler,
-                  const VectorType              &ghosted_solution,
-                  const DiscreteAction<dim>     &action,
-                  const VectorType              &lambda_h,
-                  const FluxReconstruction<dim> &flux_reconstruction,
-                  Vector<double>                &indicators,
-                  const MPI_Comm                 mpi_communicator) const;
+    flux_estimate(const DoFHandler<dim>        &dof_handler,
+                  const VectorType             &ghosted_solution,
+                  const DiscreteAction<dim>    &action,
+                  const VectorType             &lambda_h,
+                  const FluxEquilibration<dim> &flux_equilibration,
+                  Vector<double>               &indicators,
+                  const MPI_Comm                mpi_communicator) const;
 
   private:
     using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
@@ -244,11 +244,11 @@ namespace membranes
 
     /** The FluxTerms of one locally owned cell. */
     FluxTerms
-    flux_terms(const CellIterator            &cell,
-               const VectorType              &ghosted_solution,
-               const DiscreteAction<dim>     &action,
-               const FluxReconstruction<dim> &flux_reconstruction,
-               FluxScratch                   &scratch) const;
+    flux_terms(const CellIterator           &cell,
+               const VectorType             &ghosted_solution,
+               const DiscreteAction<dim>    &action,
+               const FluxEquilibration<dim> &flux_equilibration,
+               FluxScratch                  &scratch) const;
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;

@@ -29,7 +29,7 @@ namespace membranes
     types::global_dof_index vertex;
     /**
      * The key of the unknown flux through edge 2 of κ: the global DoF
-     * indices of the ends of its half-edge (see FluxReconstruction).
+     * indices of the ends of its half-edge (see FluxReconstruction::EdgeKey).
      */
     std::array<types::global_dof_index, 2> key;
     /** Outward flux of κ through edge 2 = factor × the unknown. */
@@ -65,8 +65,8 @@ namespace membranes
 
 
   /**
-   * The local problem of the patch equilibration of FluxReconstruction on
-   * the support ω_a of a condensed hat function φ_a: the field σ_ih^a in
+   * The local problem of FluxEquilibration on the support ω_a of a
+   * condensed hat function φ_a: the field σ_ih^a in
    * the Raviart–Thomas space Z_h of (4.12) on ω_a with
    *
    *   ∫_κ div σ_ih^a = ∫_κ r_ia,  r_ia = (f_i + s_i λ_a) φ_a
@@ -75,7 +75,7 @@ namespace membranes
    * on every sub-triangle κ, zero normal flux on ∂ω_a inside ω and the
    * prescribed normal flux on ∂ω, closest in the L² norm of the Gram
    * matrices of the sub-triangles to the RT0 field T_ia with the fluxes of
-   * −μ_i φ_a ∇u_ih (see the class comment of FluxReconstruction). Around an
+   * −μ_i φ_a ∇u_ih (see the class comment of FluxEquilibration). Around an
    * interior vertex the problem is solvable because ∫ r_ia = 0 is (4.5) for
    * the condensed φ_a.
    *

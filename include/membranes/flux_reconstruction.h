@@ -16,7 +16,6 @@
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
 #include <membranes/dual_cell_quadrature.h>
-#include <membranes/flux_patch_problem.h>
 #include <membranes/flux_sub_triangles.h>
 #include <membranes/problem_data.h>
 #include <string>
@@ -28,18 +27,15 @@ namespace membranes
 
   /**
    * The objects of §4.2–4.3 of the paper on the current mesh: the dual mesh
-   * D_h, λ_h as a function on it, the flux reconstructions t_ih,
+   * D_h, λ_h as a function on it, and the flux reconstructions t_ih,
    * i = 1, 2, of (4.13) in the Raviart–Thomas space Z_h = RT0(S_h) of
-   * (4.12) with the identities (4.17), (4.18) and Lemma 17, and the
-   * equilibrated fluxes σ_ih ∈ Z_h of the flux estimator.
+   * (4.12) with the identities (4.17), (4.18) and Lemma 17. The
+   * equilibrated fluxes σ_ih ∈ Z_h of the flux estimator are
+   * FluxEquilibration's, from the terms that reconstruct() computes on the
+   * same sub-triangles.
    *
-   * The parts are in four files: the fluxes (4.13) and the identities in
-   * flux_reconstruction.cc, the patch equilibration in
-   * flux_equilibration.cc (with PatchProblem in flux_patch_problem.cc),
-   * the rotation relaxation in flux_rotations.cc.
-   *
-   * λ_h and the dual cells come from DiscreteAction, which holds λ_h
-   * and the DualCellQuadrature on the pieces K ∩ D_a.
+   * λ_h comes from DiscreteAction::lambda_h(), the dual cells from the
+   * DualCellQuadrature of the DiscreteAction on the pieces K ∩ D_a.
    *
    * <h3>The fluxes t_ih (4.13)</h3>
    * On every sub-triangle κ = (a, m_e, b_K) ⊂ K, t_ih is the lowest order
@@ -90,80 +86,6 @@ namespace membranes
    * of e in D_c, weighted by w_ca = 1/2 for both parents a, cancels the
    * fine side's exactly when the density is the same on both halves of e.
    *
-   * <h3>The equilibrated flux σ_ih</h3>
-   * For the flux estimator (see ErrorEstimator) the fluxes are
-   * equilibrated patch by patch on the primal mesh (Braess and Schöberl;
-   * Ern and Vohralík), with RT0 on the sub-mesh S_h:
-   *
-   *   σ_ih = Σ_a σ_ih^a,
-   *
-   * the sum over all vertices a that carry a degree of freedom (interior,
-   * on ∂ω, not hanging), each σ_ih^a ∈ RT0(S_h) living on the support ω_a
-   * of the condensed hat function φ_a (φ_a plus the constraint weights of
-   * the hanging vertices with parent a, so that Σ_a φ_a = 1) with
-   *
-   *   ∫_κ div σ_ih^a = ∫_κ r_ia,  r_ia = (f_i + s_i λ_a) φ_a
-   *                                      − μ_i ∇u_ih·∇φ_a,
-   *
-   * on every sub-triangle κ (s_1 = 1, s_2 = −1), zero normal flux on
-   * ∂ω_a inside ω, and on ∂ω the normal flux of −μ_i φ_a ∇u_ih plus what
-   * ∫ r_ia leaves over, spread over the half-edges of ∂ω ∩ ∂ω_a in
-   * proportion to ∫ φ_a on them. Around an interior vertex the patch
-   * problem is solvable because ∫ r_ia = 0 is (4.5) for the condensed φ_a
-   * (quadrature and solver leave O(round-off), spread as a constant). Then
-   *
-   *   div σ_ih = Π_0 (f_i + s_i λ̃_h)  on every κ,  λ̃_h = Σ_a λ_a φ_a,
-   *
-   * the P1/Q1 function with the nodal values λ_a (λ̃_h ≥ 0; the estimator
-   * uses it in its residual and contact terms). Among these fields σ_ih^a
-   * minimizes, in L², the distance to the RT0 field T_ia with the fluxes
-   * of −μ_i φ_a ∇u_ih through the edges of S_h (through a half-edge
-   * between two cells the mean of both sides). The T_ia add up to a
-   * conforming field, and where u_ih is linear they satisfy the
-   * constraints themselves: then σ_ih^a = T_ia and σ_ih = −μ_i ∇u_ih
-   * exactly, which the tests check. (Minimizing the distance to
-   * −μ_i φ_a ∇u_ih itself instead loses this: the sum of the patch
-   * minimizers is then off by O(|∇u_ih|) in a strip of cells along ∂ω
-   * and wherever the mesh changes direction, an effectivity that grows
-   * like h^{−1/2}.) At an edge with a hanging node the two halves of a
-   * small edge on the fine side carry one flux density (one unknown with
-   * the coarse side's half-edge), which keeps σ_ih conforming; T_ia
-   * differs there between the two halves, so its two fluxes are replaced
-   * by one density and what moves between the two sub-triangles of the
-   * face goes back through the edge m_e–b_K between them (half the
-   * difference of the two changes each way). Where u_ih is linear the two
-   * changes are opposite (the fine side's fluxes add up to the coarse
-   * side's), T_ia so changed is admissible, and σ_ih = −μ_i ∇u_ih exactly
-   * also with hanging nodes.
-   *
-   * The sum of the patch minimizers is not the field of RT0(S_h) with
-   * this divergence that is closest to −μ_i ∇u_ih. Three sweeps of
-   * divergence-free corrections bring it closer (relax_rotations()): the
-   * curl of the hat function of each vertex p of S_h (a, m_e or b_K) is a
-   * rotation of the fluxes around p, and its coefficient is the one that
-   * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
-   * around p. Neither div σ_ih nor its normal continuity change, and the
-   * flux estimator only decreases. At an edge with a hanging vertex c the
-   * stream function stays continuous on S_h: c is the coarse side's m_e,
-   * and the midpoints of the two small edges take half of the hat
-   * functions of their ends, which carries the corrections across.
-   * Vertices on ∂ω are left out: the normal flux there stays that of the
-   * patch problems. Last, inside
-   * each cell, the curls of the quadratic edge bubbles of the edges of S_h
-   * through b_K (relax_cell_rotations()) follow the bilinear part of a Q1
-   * gradient, which no RT0 field of the sub-triangles does.
-   *
-   * Each patch problem is a PatchProblem; the sub-triangles and their
-   * Raviart–Thomas basis are a SubTriangleBasis.
-   *
-   * On several processes the support of a condensed φ_a can reach beyond
-   * the ghost layer of a process that owns one of its cells. Each process
-   * therefore writes, for its owned cells, what the patch problems need
-   * into PatchRecords (with the half-edges named by the global DoF indices
-   * of their end vertices, the same on every process), sends them
-   * to the owner of a, which solves the patch problem and sends σ_ih^a back
-   * (Utilities::MPI::some_to_some).
-   *
    * <h3>Quadrilaterals</h3>
    * The construction is the same on the pieces of Q1 cells, with the
    * Raviart–Thomas fields mapped from the reference sub-triangles by the
@@ -173,6 +95,9 @@ namespace membranes
    * the fluxes (4.13) integrated along the edges. The gradient of a Q1
    * function is not constant on K, so (4.17) and (4.18) no longer hold
    * exactly: identities() reports their defects instead.
+   *
+   * The sub-triangles and their Raviart–Thomas basis are a
+   * SubTriangleBasis.
    */
   template <int dim>
   class FluxReconstruction
@@ -209,17 +134,79 @@ namespace membranes
                        const DiscreteAction<dim> &action);
 
     /**
-     * Compute t_1h, t_2h and σ_1h, σ_2h for @p ghosted_solution and its
-     * @p lambda_h (DiscreteAction::lambda_h()) on the locally owned cells of
-     * @p dof_handler.
+     * An edge or a half-edge of the mesh, by the global DoF indices (of
+     * u_1h) of its end vertices, which are exact and the same on every
+     * process: an edge by its two ends in increasing order, the half-edge
+     * a–m_e of the edge (a, b) by (a, b). (Two vertices end at most one
+     * edge, and an edge is named either whole or by its two halves, so
+     * names never meet.)
      */
-    void
-    reconstruct(const DoFHandler<dim>           &dof_handler,
-                const VectorType                &ghosted_solution,
-                const VectorType                &lambda_h,
-                const AffineConstraints<double> &hanging_node_constraints,
-                const IndexSet                  &locally_owned_dofs,
-                const MPI_Comm                   mpi_communicator);
+    using EdgeKey = std::array<types::global_dof_index, 2>;
+
+    /**
+     * What the reconstruction keeps of one sub-triangle κ. The type is
+     * trivial: the arrays of all sub-triangles are allocated without
+     * initial values, and the cell loop of reconstruct() sets the entries of
+     * each cell to zero (SubTriangleData{}) on the thread that fills them,
+     * instead of a serial pass over hundreds of megabytes before it.
+     */
+    struct SubTriangleData
+    {
+      /** Outward normal fluxes of t_ih through the edges of κ, per i. */
+      std::array<std::array<double, 3>, 2> fluxes;
+      /** (ψ_k, ψ_l)_κ for the mapped Raviart–Thomas basis of κ. */
+      std::array<std::array<double, 3>, 3> gram;
+      /** (μ_i ∇u_ih, ψ_k)_κ. */
+      std::array<std::array<double, 3>, 2> discrete_flux;
+      /**
+       * (β_l, β_m)_κ for the curls β_l of the edge bubbles 4 λ_p λ_q of the
+       * edges l = 0, 1 of κ, those through b_K (the rotations inside a cell
+       * of FluxEquilibration).
+       */
+      std::array<std::array<double, 2>, 2> rotation_gram;
+      /** (ψ_k, β_l)_κ. */
+      std::array<std::array<double, 2>, 3> mixed_gram;
+      /** (μ_i ∇u_ih, β_l)_κ. */
+      std::array<std::array<double, 2>, 2> discrete_rotation;
+      /** ∫_κ f_i. */
+      std::array<double, 2> load;
+      double                area;
+    };
+
+    /**
+     * The terms of the patch problems of FluxEquilibration on one
+     * sub-triangle κ: for the hat function φ_v of each vertex v of the cell
+     * ∫_κ (f_i φ_v − μ_i ∇u_ih·∇φ_v) and ∫_κ φ_v; at the two Gauss points of
+     * each edge of κ the weighted flux density μ_i ∇u_ih·n ds; and the
+     * weighted length ds at those of edge 2 if it lies on ∂ω; the key of its
+     * half-edge. Trivial like SubTriangleData.
+     */
+    struct PatchTerms
+    {
+      std::array<std::array<double, 4>, 2>                hat_residual;
+      std::array<double, 4>                               hat_mass;
+      std::array<std::array<std::array<double, 2>, 3>, 2> edge_flux;
+      std::array<double, 2>                               boundary_length;
+      /**
+       * The key of the unknown flux through edge 2 of κ, the factor that
+       * gives κ's outward flux from it, and whether edge 2 lies on ∂ω (see
+       * FluxEquilibration).
+       */
+      EdgeKey key;
+      double  factor;
+      bool    on_boundary;
+    };
+
+    /**
+     * Compute t_1h, t_2h for @p ghosted_solution on the locally owned
+     * cells of @p dof_handler (and what they need of the ghost cells).
+     * Returns the PatchTerms of the sub-triangles of the owned cells, by
+     * active cell index × sub-triangles per cell + sub-triangle, for
+     * FluxEquilibration::equilibrate().
+     */
+    AlignedVector<PatchTerms>
+    reconstruct(const DoFHandler<dim> &dof_handler,
+                const VectorType      &ghosted_solution);
 
     /**
      * The defects of the identities for the t_ih of the last reconstruct(),
@@ -230,18 +217,6 @@ namespace membranes
     identities(const AffineConstraints<double> &hanging_node_constraints,
                const IndexSet                  &locally_owned_dofs,
                const MPI_Comm                   mpi_communicator) const;
-
-    /**
-     * σ_ih and div σ_ih of membrane @p i at the points of
-     * DiscreteAction::dual_quadrature() on the cell @p fe_values was last
-     * reinit'ed on (with update_jacobians).
-     */
-    void
-    flux_values(const CellIterator          &cell,
-                const unsigned int           i,
-                const FEValues<dim>         &fe_values,
-                std::vector<Tensor<1, dim>> &fluxes,
-                std::vector<double>         &divergences) const;
 
     /**
      * f_i at the points of DiscreteAction::dual_quadrature() on @p cell, as
@@ -263,79 +238,22 @@ namespace membranes
     static std::vector<std::string>
     data_names();
 
+    /** The DoFHandler of the last reconstruct(). */
+    const DoFHandler<dim> &
+    get_dof_handler() const;
+
+    /** The sub-triangles and their Raviart–Thomas basis. */
+    const SubTriangleBasis<dim> &
+    sub_triangle_basis() const;
+
+    /**
+     * The SubTriangleData of the last reconstruct(), by active cell index ×
+     * sub-triangles per cell + sub-triangle.
+     */
+    const AlignedVector<SubTriangleData> &
+    sub_triangles() const;
+
   private:
-    /**
-     * An edge or a half-edge of the mesh, by the global DoF indices (of
-     * u_1h) of its end vertices, which are exact and the same on every
-     * process: an edge by its two ends in increasing order, the half-edge
-     * a–m_e of the edge (a, b) by (a, b). (Two vertices end at most one
-     * edge, and an edge is named either whole or by its two halves, so
-     * names never meet.)
-     */
-    using EdgeKey = std::array<types::global_dof_index, 2>;
-
-    /** The coefficients of a condensed φ_a in the hat functions of a cell. */
-    using HatCoefficients =
-      std::array<double, GeometryInfo<dim>::vertices_per_cell>;
-
-    /**
-     * What the reconstruction keeps of one sub-triangle κ. The type is
-     * trivial: the arrays of all sub-triangles are allocated without
-     * initial values, and the cell loop of reconstruct() sets the entries of
-     * each cell to zero (SubTriangleData{}) on the thread that fills them,
-     * instead of a serial pass over hundreds of megabytes before it.
-     */
-    struct SubTriangleData
-    {
-      /** Outward normal fluxes of t_ih through the edges of κ, per i. */
-      std::array<std::array<double, 3>, 2> fluxes;
-      /** The same for the equilibrated flux σ_ih. */
-      std::array<std::array<double, 3>, 2> equilibrated;
-      /** (ψ_k, ψ_l)_κ for the mapped Raviart–Thomas basis of κ. */
-      std::array<std::array<double, 3>, 3> gram;
-      /** (μ_i ∇u_ih, ψ_k)_κ. */
-      std::array<std::array<double, 3>, 2> discrete_flux;
-      /**
-       * Coefficients of the rotations inside the cell: the curls β_l of
-       * the edge bubbles 4 λ_p λ_q of the edges l = 0, 1 of κ, those
-       * through b_K (see relax_cell_rotations()), per i.
-       */
-      std::array<std::array<double, 2>, 2> rotations;
-      /** (β_l, β_m)_κ. */
-      std::array<std::array<double, 2>, 2> rotation_gram;
-      /** (ψ_k, β_l)_κ. */
-      std::array<std::array<double, 2>, 3> mixed_gram;
-      /** (μ_i ∇u_ih, β_l)_κ. */
-      std::array<std::array<double, 2>, 2> discrete_rotation;
-      /** ∫_κ f_i. */
-      std::array<double, 2> load;
-      double                area;
-    };
-
-    /**
-     * The terms of the patch problems on one sub-triangle κ: for the hat
-     * function φ_v of each vertex v of the cell ∫_κ (f_i φ_v −
-     * μ_i ∇u_ih·∇φ_v) and ∫_κ φ_v; at the two Gauss points of each edge of
-     * κ the weighted flux density μ_i ∇u_ih·n ds; and the weighted length
-     * ds at those of edge 2 if it lies on ∂ω; the key of its half-edge.
-     * Kept only while reconstruct() runs; trivial like SubTriangleData.
-     */
-    struct PatchTerms
-    {
-      std::array<std::array<double, 4>, 2>                hat_residual;
-      std::array<double, 4>                               hat_mass;
-      std::array<std::array<std::array<double, 2>, 3>, 2> edge_flux;
-      std::array<double, 2>                               boundary_length;
-      /**
-       * The key of the unknown flux through edge 2 of κ, the factor that
-       * gives κ's outward flux from it, and whether edge 2 lies on ∂ω (see
-       * write_patch_record()).
-       */
-      EdgeKey key;
-      double  factor;
-      bool    on_boundary;
-    };
-
     /** @name The fluxes t_ih of (4.13) (flux_reconstruction.cc) */
     /** @{ */
 
@@ -406,153 +324,6 @@ namespace membranes
     /** The minimizers: the fluxes of t_ih through the half-edges. */
     void
     set_half_edge_fluxes(const HalfEdgeMinimization &minimization);
-
-    /** @} */
-
-    /** @name The patch equilibration (flux_equilibration.cc) */
-    /** @{ */
-
-    /**
-     * A cell K in the support of the condensed hat function φ_a, with the
-     * coefficients of φ_a in the hat functions of K's vertices (1 at a, the
-     * constraint weight at a hanging vertex with parent a).
-     */
-    struct PatchMember
-    {
-      types::global_dof_index a;
-      CellIterator            cell;
-      HatCoefficients         coefficients;
-    };
-
-    /**
-     * The records exchanged with other processes: the cells whose records
-     * went to each process, the records received from each process, by the
-     * vertex a the records of its patch (process, record of a cell), and
-     * the buffers of the answers, σ_ih^a on the received sub-triangles.
-     */
-    struct RemotePatches
-    {
-      std::map<unsigned int, std::vector<CellIterator>> sent;
-      std::map<unsigned int, std::vector<PatchRecord>>  received;
-      std::map<types::global_dof_index,
-               std::vector<std::pair<unsigned int, unsigned int>>>
-                                                  members;
-      std::map<unsigned int, std::vector<double>> replies;
-    };
-
-    /** The work arrays of one thread of solve_patches(). */
-    struct PatchScratch;
-    /** σ_ih^a of one patch on its owned cells. */
-    struct PatchCopy;
-
-    /**
-     * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch
-     * problems on the supports of the condensed hat functions φ_a (see the
-     * class comment), each solved by the owner of a on the records of its
-     * cells, with @p patch_terms from reconstruct(); then the rotations.
-     */
-    void
-    equilibrate(const AlignedVector<PatchTerms> &patch_terms,
-                const VectorType                &lambda_h,
-                const AffineConstraints<double> &hanging_node_constraints,
-                const IndexSet                  &locally_owned_dofs,
-                const MPI_Comm                   mpi_communicator);
-
-    /**
-     * The members of the patches of the owned cells, in the order of the
-     * cells and, on each cell, by increasing a.
-     */
-    std::vector<PatchMember>
-    patch_members(
-      const AffineConstraints<double> &hanging_node_constraints) const;
-
-    /**
-     * Send the records of @p remote_members to the owners of their a and
-     * receive the records of the patches of the owned vertices.
-     */
-    RemotePatches
-    send_patch_records(const std::vector<PatchMember>  &remote_members,
-                       const AlignedVector<PatchTerms> &patch_terms,
-                       const IndexSet                  &locally_owned_dofs,
-                       const MPI_Comm                   mpi_communicator) const;
-
-    /**
-     * The patch problems of the owned vertices, on threads, with the
-     * members @p local_members (sorted by a) and the records of @p remote;
-     * adds σ_ih^a on the owned cells, writes it to the replies of @p remote
-     * on the others.
-     */
-    void
-    solve_patches(const std::vector<PatchMember>  &local_members,
-                  const AlignedVector<PatchTerms> &patch_terms,
-                  const VectorType                &lambda_h,
-                  RemotePatches                   &remote);
-
-    /**
-     * The worker of solve_patches(): the patch problem of the members
-     * local_members[first, end), which share their a.
-     */
-    void
-    solve_patch(const unsigned int               first,
-                const unsigned int               end,
-                const std::vector<PatchMember>  &local_members,
-                const AlignedVector<PatchTerms> &patch_terms,
-                const VectorType                &lambda_h,
-                RemotePatches                   &remote,
-                PatchScratch                    &scratch,
-                PatchCopy                       &copy) const;
-
-    /**
-     * Write the records of the sub-triangles of @p cell (in the order of
-     * the ring) for the patch problem of the condensed hat function φ_a
-     * with @p coefficients on @p cell to @p record.
-     */
-    void
-    write_patch_record(const CellIterator              &cell,
-                       const types::global_dof_index    a,
-                       const HatCoefficients           &coefficients,
-                       const AlignedVector<PatchTerms> &patch_terms,
-                       PatchRecord                     *record) const;
-
-    /** Add the fluxes @p result of one patch problem to σ_ih on @p cell. */
-    void
-    add_patch_result(const CellIterator &cell, const double *result);
-
-    /** @} */
-
-    /** @name The rotation relaxation (flux_rotations.cc) */
-    /** @{ */
-
-    /** The rotations around the vertices of S_h (see the .cc file). */
-    struct Rotations;
-
-    /**
-     * Divergence-free corrections of σ_ih on the locally owned cells: the
-     * curls of the hat functions of the vertices of S_h, each chosen to
-     * minimize the distance of σ_ih from −μ_i ∇u_ih around its vertex,
-     * in rotation_sweeps sweeps (see the .cc file).
-     */
-    void
-    relax_rotations();
-
-    /**
-     * The rotations around the vertices p of S_h not on ∂ω that an owned
-     * cell touches, grouped by the kind of p.
-     */
-    Rotations
-    rotations_around_vertices() const;
-
-    /** Sweeps of relax_rotations(). */
-    static constexpr unsigned int rotation_sweeps = 3;
-
-    /**
-     * Rotations inside each locally owned cell: the curls of the edge
-     * bubbles of the edges of S_h through b_K, with the coefficients that
-     * minimize the distance of σ_ih from −μ_i ∇u_ih on the cell (see the
-     * .cc file).
-     */
-    void
-    relax_cell_rotations();
 
     /** @} */
 

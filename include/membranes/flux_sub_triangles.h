@@ -80,7 +80,7 @@ namespace membranes
    * quadratic edge bubbles 4 λ_p λ_q of the edges l = 0, 1 of κ (those
    * through b_K) are fields without divergence and without normal flux
    * through ∂K, mapped the same way (see
-   * FluxReconstruction::relax_cell_rotations()).
+   * FluxEquilibration::relax_cell_rotations()).
    *
    * The sub-triangles of a cell form a ring around b_K: ring()[j] and
    * ring()[j+1] share edge 0 (m_e–b_K) of ring()[j] for even j, edge 1

@@ -52,6 +52,8 @@ namespace membranes
    */
   template <int dim>
   class FluxReconstruction;
+  template <int dim>
+  class FluxEquilibration;
 
 
 
@@ -144,6 +146,7 @@ namespace membranes
     ActiveSetSolver<dim> active_set_solver;
     /** t_ih and σ_ih, only when the scene asks for fluxes. */
     std::unique_ptr<FluxReconstruction<dim>> flux_reconstruction;
+    std::unique_ptr<FluxEquilibration<dim>>  flux_equilibration;
     Report                                   report;
     FieldOutput<dim>                         field_output;
     /** Held from the start of the first cycle to the end of the run. */
