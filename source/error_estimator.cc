@@ -179,7 +179,11 @@ namespace membranes
 
     // Every interior edge once, from its finer side (or from the cell with
     // the smaller index between cells of the same level); half of the
-    // term goes to each of the two cells, in the copier. Ghost cells take
+    // term goes to each of the two cells, in the copier. (This is what
+    // MeshWorker::mesh_loop with assemble_own_interior_faces_once does; its
+    // face worker would reinit an FEInterfaceValues on every edge, which on
+    // triangles the jumps of the constant P1 gradients of the cells,
+    // computed once per cell by p1_gradients(), do not need.) Ghost cells take
     // part, so that an edge between an owned and a ghost cell counts
     // whichever side computes it (ghost cells' indicators are dropped
     // later).

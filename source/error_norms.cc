@@ -23,6 +23,13 @@ namespace membranes
                            const VectorType          &lambda_h,
                            const MPI_Comm             mpi_communicator) const
   {
+    // All five norms in one pass over the cells, at the points of the
+    // dual-cell quadrature, which λ_h needs: one call of the exact solution
+    // (ProblemData::exact_solution_list(), compiled) gives u1, u2, their
+    // gradients and λ together. VectorTools::integrate_difference() would
+    // take one pass and one evaluation of the exact solution per norm and
+    // membrane, four for the displacements.
+    //
     // What one thread needs on a cell: u_h, λ_h, u, λ and the gradients
     // at the points of the dual-cell quadrature.
     struct Scratch
