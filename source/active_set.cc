@@ -138,7 +138,7 @@ namespace membranes
     return std::max(
       {sum_equilibrium / force_scale,
        contact_equilibrium / contact_force_scale,
-       std::max(0., -min_gap) / displacement_scale,
+       std::max(0., -min_w) / displacement_scale,
        std::max(0., -min_contact_force) / contact_force_scale,
        complementarity / (contact_force_scale * displacement_scale)});
   }
@@ -315,7 +315,7 @@ namespace membranes
         if (!is_element(a.dof[0]))
           defects.contact_equilibrium =
             std::max(defects.contact_equilibrium, std::abs(contact_force));
-        defects.min_gap    = std::min(defects.min_gap, w);
+        defects.min_w      = std::min(defects.min_w, w);
         defects.min_lambda = std::min(defects.min_lambda, lambda);
         defects.min_contact_force =
           std::min(defects.min_contact_force, contact_force);
@@ -328,7 +328,7 @@ namespace membranes
                             &defects.complementarity})
       *maximum = Utilities::MPI::max(*maximum, mpi_communicator);
     for (double *minimum :
-         {&defects.min_gap, &defects.min_lambda, &defects.min_contact_force})
+         {&defects.min_w, &defects.min_lambda, &defects.min_contact_force})
       *minimum = Utilities::MPI::min(*minimum, mpi_communicator);
     return defects;
   }

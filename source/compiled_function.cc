@@ -98,11 +98,12 @@ namespace membranes
      * or -1 if it could not be started.
      */
     int
-    run(const std::vector<std::string> &arguments, const std::string &log)
+    run(std::vector<std::string> arguments, const std::string &log)
     {
+      // posix_spawnp() takes the arguments as char *: those of the copy.
       std::vector<char *> argv;
-      for (const std::string &argument : arguments)
-        argv.push_back(const_cast<char *>(argument.c_str()));
+      for (std::string &argument : arguments)
+        argv.push_back(argument.data());
       argv.push_back(nullptr);
       posix_spawn_file_actions_t actions;
       posix_spawn_file_actions_init(&actions);

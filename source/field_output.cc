@@ -79,12 +79,12 @@ namespace membranes
                               const VectorType      &lambda_and_active_flags,
                               const Vector<double>  *indicators)
   {
-    const WPostprocessor<dim> gap;
+    const WPostprocessor<dim> w;
     DataOut<dim>              data_out;
     data_out.attach_dof_handler(dof_handler);
     data_out.add_data_vector(ghosted_solution,
                              std::vector<std::string>{"u1", "u2"});
-    data_out.add_data_vector(ghosted_solution, gap);
+    data_out.add_data_vector(ghosted_solution, w);
     data_out.add_data_vector(lambda_and_active_flags,
                              std::vector<std::string>{"lambda_h",
                                                       "active_set"});

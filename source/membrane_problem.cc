@@ -329,7 +329,7 @@ namespace membranes
         ++hanging_active;
     record.hanging_active_vertices =
       Utilities::MPI::sum(hanging_active, mpi_communicator);
-    record.min_w         = defects.min_gap;
+    record.min_w         = defects.min_w;
     record.min_lambda    = defects.min_lambda;
     record.prop12_defect = defects.sum_equilibrium / force_scale;
     record.complementarity_defect =

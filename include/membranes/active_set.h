@@ -142,7 +142,7 @@ namespace membranes
   {
     double sum_equilibrium;
     double contact_equilibrium;
-    double min_gap;
+    double min_w;
     double min_lambda;
     double min_contact_force;
     double complementarity;

@@ -1,7 +1,6 @@
 #ifndef membranes_active_set_system_h
 #define membranes_active_set_system_h
 
-#include <deal.II/base/function.h>
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
@@ -13,7 +12,6 @@
 #include <membranes/linear_solver.h>
 #include <membranes/parameters.h>
 #include <membranes/problem_data.h>
-#include <optional>
 #include <string>
 
 namespace membranes

@@ -1,13 +1,10 @@
 #ifndef membranes_decoupled_system_h
 #define membranes_decoupled_system_h
 
-#include <array>
-#include <deal.II/base/function.h>
 #include <deal.II/base/smartpointer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <membranes/active_set_system.h>
-#include <memory>
 #include <vector>
 
 namespace membranes
