@@ -30,12 +30,11 @@ namespace membranes
    *   matrix(j, k) = μ_c A_K(v(j), v(k))  if c(j) = c(k), 0 otherwise,
    *   rhs(j)       = F_cK(v(j)),    lumped_mass(j) = m_K(v(j)).
    *
-   * DiscreteProblem assembles the operator and the loads of the mesh from the
-   * FESystem parts, once per mesh, and keeps the loads F_iK of each cell;
-   * the systems of the active set method condense the loads of each cell
-   * (the coupled one from the FESystem parts, the decoupled one from F_iK)
-   * and take their matrices from the mesh's operator: all see the same
-   * bilinear form and the same quadrature of the loads.
+   * DiscreteProblem assembles the Laplacian and the loads of the mesh from
+   * the scalar parts, once per mesh, and keeps the loads F_iK of each cell;
+   * CoupledSystem assembles its system from the FESystem parts with those
+   * cell loads, and DecoupledSystem the matrix of w from A_K: all see the
+   * same bilinear form and the same quadrature of the loads.
    */
   template <int dim>
   class CellSystem
