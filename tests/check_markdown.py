@@ -18,7 +18,11 @@ directory of this script):
   have balanced math: every ``$`` that opens inline math closes in the same
   paragraph, every ``$$`` that opens display math closes before the end of
   the file, and no single ``$`` stands inside display math. ``\\$`` and the
-  contents of code spans and fenced code blocks do not count.
+  contents of code spans and fenced code blocks do not count. Inside inline
+  math there is no backslash before ``{ } | , ! ;``: GitHub's Markdown
+  removes it before the math is typeset (``\\{`` renders as ``{``, ``\\|``
+  as ``|``); ``\\lbrace``, ``\\rbrace``, ``\\Vert`` and ``\\vert`` render,
+  and a thin space is not needed.
 
 With FILE arguments, both checks apply to each FILE (to try the checks on a
 file of one's own).
@@ -37,6 +41,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f\x80-\x9f]")
 FENCE = re.compile(r"^ {0,3}(`{3,}|~{3,})")
+# What GitHub's Markdown unescapes inside inline math.
+ESCAPED = tuple("{}|,!;")
 
 
 def markdown_files():
@@ -114,6 +120,11 @@ def unbalanced_math(name, text):
                 i += 2
                 continue
             if c == "\\" and (inline is not None or display is not None):
+                if inline is not None and line[i + 1:i + 2] in ESCAPED:
+                    defects.append(f"{name}:{number}: '\\{line[i + 1]}' in "
+                                   "inline math: GitHub drops the "
+                                   "backslash (use \\lbrace, \\rbrace, "
+                                   "\\Vert, \\vert, or no thin space)")
                 i += 2
                 continue
             if c == "`" and inline is None and display is None:
