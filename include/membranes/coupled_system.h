@@ -5,7 +5,6 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <membranes/active_set_system.h>
-#include <vector>
 
 namespace membranes
 {
