@@ -64,7 +64,7 @@ import adaptivity_table  # noqa: E402
 from solver_cost_table import number as value, read_report  # noqa: E402
 
 ERROR_COLUMNS = ["err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2",
-                 "err_lambda_L2"]
+                 "err_lambda_L2", "err_lambda_L2_omega_h"]
 
 
 def labelled(arguments):

@@ -23,7 +23,7 @@ namespace membranes
                            const VectorType          &lambda_h,
                            const MPI_Comm             mpi_communicator) const
   {
-    // All five norms in one pass over the cells, at the points of the
+    // All six norms in one pass over the cells, at the points of the
     // dual-cell quadrature, which λ_h needs: one call of the exact solution
     // (ProblemData::exact_solution_list(), compiled) gives u1, u2, their
     // gradients and λ together. VectorTools::integrate_difference() would
@@ -56,7 +56,7 @@ namespace membranes
       typename ProblemData<dim>::ExactValues     exact;
     };
     // Squared norms on one cell, and summed over the locally owned cells.
-    using Squares = std::array<double, 5>;
+    using Squares = std::array<double, 6>;
     Squares squares{};
 
     run_on_cells<Squares>(
@@ -94,9 +94,12 @@ namespace membranes
                 cell_squares[2 + i] +=
                   std::pow(exact.u[i][q] - scratch.uh[i][q], 2) * JxW;
               }
-            if (scratch.values.in_omega_h[q])
-              cell_squares[4] +=
-                std::pow(exact.lambda[q] - scratch.values.lambda_h[q], 2) * JxW;
+            // λ_h = 0 on the strip ω ∖ ω_h.
+            const bool   in_omega_h = scratch.values.in_omega_h[q];
+            const double lambda_error =
+              exact.lambda[q] - (in_omega_h ? scratch.values.lambda_h[q] : 0.);
+            cell_squares[in_omega_h ? 4 : 5] +=
+              lambda_error * lambda_error * JxW;
           }
       },
       [&](const Squares &cell_squares) {
@@ -105,8 +108,11 @@ namespace membranes
       });
 
     for (double &square : squares)
-      square = std::sqrt(Utilities::MPI::sum(square, mpi_communicator));
-    return {{{squares[0], squares[1]}}, {{squares[2], squares[3]}}, squares[4]};
+      square = Utilities::MPI::sum(square, mpi_communicator);
+    return {{{std::sqrt(squares[0]), std::sqrt(squares[1])}},
+            {{std::sqrt(squares[2]), std::sqrt(squares[3])}},
+            std::sqrt(squares[4] + squares[5]),
+            std::sqrt(squares[4])};
   }
 
 

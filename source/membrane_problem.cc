@@ -273,14 +273,15 @@ namespace membranes
    * included) per iteration.
    */
   template <int dim>
-  void
+  SolveRecord
   MembraneProblem<dim>::solve()
   {
     ActiveSetStatistics statistics;
     const double        expected_error =
       previous_record.estimator ?
                *previous_record.estimator *
-          std::sqrt(static_cast<double>(previous_record.dofs) / record.dofs) :
+          std::sqrt(static_cast<double>(previous_record.mesh.dofs) /
+                    record.mesh.dofs) :
                0.;
     try
       {
@@ -289,18 +290,18 @@ namespace membranes
       }
     catch (const ActiveSetNotConverged &error)
       {
-        throw ActiveSetNotConverged("cycle " + std::to_string(record.cycle) +
-                                    ": " + error.what() + "; " +
-                                    write_unconverged_iterate());
+        throw ActiveSetNotConverged(
+          "cycle " + std::to_string(record.mesh.cycle) + ": " + error.what() +
+          "; " + write_unconverged_iterate());
       }
     ghosted_solution = solution;
 
-    record.active_set_iterations  = statistics.iterations;
-    record.linear_iterations      = statistics.linear_iterations;
-    record.kkt_residual           = statistics.kkt_residual;
-    record.linearization_estimate = statistics.linearization_estimate;
-    record.algebraic_estimate     = statistics.algebraic_estimate;
-    record.active_vertices        = active_set.n_active_vertices();
+    return {statistics.iterations,
+            active_set.n_active_vertices(),
+            statistics.linear_iterations,
+            statistics.kkt_residual,
+            statistics.linearization_estimate,
+            statistics.algebraic_estimate};
   }
 
 
@@ -313,7 +314,7 @@ namespace membranes
    * displacements by max |u_h|; and min_a λ_a, min_a (u1h − u2h)(a).
    */
   template <int dim>
-  void
+  IdentityRecord
   MembraneProblem<dim>::postprocess()
   {
     lambda_h = action.lambda_h(hanging_node_constraints);
@@ -327,13 +328,11 @@ namespace membranes
     for (const auto dof : active_set.locally_owned())
       if (hanging_node_constraints.is_constrained(dof))
         ++hanging_active;
-    record.hanging_active_vertices =
-      Utilities::MPI::sum(hanging_active, mpi_communicator);
-    record.min_w         = defects.min_w;
-    record.min_lambda    = defects.min_lambda;
-    record.prop12_defect = defects.sum_equilibrium / force_scale;
-    record.complementarity_defect =
-      defects.complementarity / (force_scale * u_scale);
+    return {Utilities::MPI::sum(hanging_active, mpi_communicator),
+            defects.min_w,
+            defects.min_lambda,
+            defects.sum_equilibrium / force_scale,
+            defects.complementarity / (force_scale * u_scale)};
   }
 
 
@@ -345,27 +344,32 @@ namespace membranes
    * part of the wall time of the method.
    */
   template <int dim>
-  void
+  std::optional<ErrorRecord>
   MembraneProblem<dim>::compute_errors()
   {
-    if (data.exact_solution_known())
-      {
-        TimerOutput::Scope scope(computing_timer, "errors");
-        const auto         errors = ErrorNorms<dim>(discretization, data)
-                              .compute(dof_handler,
-                                       ghosted_solution,
-                                       action,
-                                       lambda_h,
-                                       mpi_communicator);
-        record.err_u1_H1     = errors.u_H1[0];
-        record.err_u2_H1     = errors.u_H1[1];
-        record.err_u1_L2     = errors.u_L2[0];
-        record.err_u2_L2     = errors.u_L2[1];
-        record.err_lambda_L2 = errors.lambda_L2;
-        record.err_energy =
-          std::sqrt(data.mu[0] * errors.u_H1[0] * errors.u_H1[0] +
-                    data.mu[1] * errors.u_H1[1] * errors.u_H1[1]);
-      }
+    if (!data.exact_solution_known())
+      return {};
+    TimerOutput::Scope scope(computing_timer, "errors");
+    const auto         errors = ErrorNorms<dim>(discretization, data)
+                          .compute(dof_handler,
+                                   ghosted_solution,
+                                   action,
+                                   lambda_h,
+                                   mpi_communicator);
+    // The full H1 norm of (3.5) from the seminorm and the L2 norm.
+    const auto full_norm = [&](const unsigned int i) {
+      return std::sqrt(std::pow(errors.u_H1_seminorm[i], 2) +
+                       std::pow(errors.u_L2[i], 2));
+    };
+    return ErrorRecord{full_norm(0),
+                       full_norm(1),
+                       errors.u_L2[0],
+                       errors.u_L2[1],
+                       errors.lambda_L2,
+                       errors.lambda_L2_omega_h,
+                       std::sqrt(
+                         data.mu[0] * std::pow(errors.u_H1_seminorm[0], 2) +
+                         data.mu[1] * std::pow(errors.u_H1_seminorm[1], 2))};
   }
 
 
@@ -392,7 +396,7 @@ namespace membranes
    * flux estimator drives refinement (reconstruct_fluxes()).
    */
   template <int dim>
-  void
+  std::optional<double>
   MembraneProblem<dim>::estimate_error()
   {
     const bool adaptive = parameters.refinement.strategy ==
@@ -404,20 +408,19 @@ namespace membranes
     const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
     if (!(drives && !flux_drives) && !data.exact_solution_known() && !balanced)
-      return;
+      return {};
     TimerOutput::Scope scope(computing_timer, "estimate");
     Vector<double>     residual_indicators;
-    record.estimator = ErrorEstimator<dim>(discretization, data)
+    const double       eta = ErrorEstimator<dim>(discretization, data)
                          .residual_estimate(dof_handler,
                                             ghosted_solution,
                                             action,
                                             lambda_h,
                                             residual_indicators,
                                             mpi_communicator);
-    if (record.err_energy)
-      record.effectivity = *record.estimator / *record.err_energy;
     if (!flux_drives)
       indicators.swap(residual_indicators);
+    return eta;
   }
 
 
@@ -430,11 +433,11 @@ namespace membranes
    * indicators are kept for marking when it drives refinement.
    */
   template <int dim>
-  void
+  std::optional<FluxRecord>
   MembraneProblem<dim>::reconstruct_fluxes()
   {
     if (!computes_fluxes())
-      return;
+      return {};
     TimerOutput::Scope scope(computing_timer, "flux");
     flux_equilibration->equilibrate(
       flux_reconstruction->reconstruct(dof_handler, ghosted_solution),
@@ -442,15 +445,16 @@ namespace membranes
       hanging_node_constraints,
       locally_owned_dofs,
       mpi_communicator);
+    FluxRecord flux;
     if (parameters.output.flux_reconstruction)
       {
         const auto identities =
           flux_reconstruction->identities(hanging_node_constraints,
                                           locally_owned_dofs,
                                           mpi_communicator);
-        record.measure_defect      = identities.measure_defect;
-        record.conservation_defect = identities.conservation_defect;
-        record.balance_defect      = identities.balance_defect;
+        flux.measure_defect      = identities.measure_defect;
+        flux.conservation_defect = identities.conservation_defect;
+        flux.balance_defect      = identities.balance_defect;
       }
 
     Vector<double> flux_indicators;
@@ -462,15 +466,14 @@ namespace membranes
                                            *flux_equilibration,
                                            flux_indicators,
                                            mpi_communicator);
-    record.flux_estimator             = estimate.eta;
-    record.flux_estimator_flux        = estimate.flux;
-    record.flux_estimator_oscillation = estimate.oscillation;
-    record.flux_estimator_contact     = estimate.contact;
-    record.flux_estimator_boundary    = estimate.boundary;
-    if (record.err_energy)
-      record.flux_effectivity = estimate.eta / *record.err_energy;
+    flux.estimator   = estimate.eta;
+    flux.flux        = estimate.flux;
+    flux.oscillation = estimate.oscillation;
+    flux.contact     = estimate.contact;
+    flux.boundary    = estimate.boundary;
     if (parameters.refinement.estimator == Parameters::Estimator::flux)
       indicators.swap(flux_indicators);
+    return flux;
   }
 
 
@@ -495,7 +498,7 @@ namespace membranes
     create_output_directory(output.directory);
     const std::vector<std::string> files =
       FieldOutput<dim>(output, discretization, mpi_communicator)
-        .write(record.cycle,
+        .write(record.mesh.cycle,
                dof_handler,
                ghosted_solution,
                active_set.lambda_and_flags(lambda_h),
@@ -651,8 +654,8 @@ namespace membranes
    * a number in its row.)
    */
   template <int dim>
-  void
-  MembraneProblem<dim>::record_phase_times()
+  TimeRecord
+  MembraneProblem<dim>::phase_times() const
   {
     const std::map<std::string, double> times =
       computing_timer.get_summary_data(TimerOutput::total_wall_time);
@@ -661,15 +664,17 @@ namespace membranes
       return Utilities::MPI::max(time == times.end() ? 0. : time->second,
                                  mpi_communicator);
     };
-    record.time_setup       = time_of("setup");
-    record.time_assembly    = time_of("assembly");
-    record.time_solve       = time_of("solve");
-    record.time_postprocess = time_of("postprocess");
-    record.time_estimate    = time_of("estimate");
+    TimeRecord phases;
+    phases.setup       = time_of("setup");
+    phases.assembly    = time_of("assembly");
+    phases.solve       = time_of("solve");
+    phases.postprocess = time_of("postprocess");
+    phases.estimate    = time_of("estimate");
     if (computes_fluxes())
-      record.time_flux = time_of("flux");
+      phases.flux = time_of("flux");
     if (data.exact_solution_known())
-      record.time_errors = time_of("errors");
+      phases.errors = time_of("errors");
+    return phases;
   }
 
 
@@ -682,10 +687,11 @@ namespace membranes
   bool
   MembraneProblem<dim>::target_reached() const
   {
-    const double target = parameters.refinement.target_estimator;
-    const std::optional<double> &eta =
+    const double                target = parameters.refinement.target_estimator;
+    const std::optional<double> eta =
       (parameters.refinement.estimator == Parameters::Estimator::flux ?
-         record.flux_estimator :
+         (record.flux ? std::optional<double>(record.flux->estimator) :
+                        std::nullopt) :
          record.estimator);
     if (!(target > 0 && eta && *eta <= target))
       return false;
@@ -705,8 +711,7 @@ namespace membranes
     double cumulative_time = 0;
     for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
       {
-        record       = CycleRecord();
-        record.cycle = cycle;
+        record = CycleRecord();
 
         computing_timer.reset();
         TimerOutput::Scope setup_scope(computing_timer, "setup");
@@ -731,42 +736,37 @@ namespace membranes
           }
         transfer_solution();
         setup_scope.stop();
-        record.cells  = triangulation->n_global_active_cells();
-        record.levels = triangulation->n_global_levels();
-        record.dofs   = dof_handler.n_dofs();
-        pcout << "Cycle " << cycle << ": " << record.cells << " cells, "
-              << record.dofs << " DoFs";
+        record.mesh = {cycle,
+                       triangulation->n_global_active_cells(),
+                       triangulation->n_global_levels(),
+                       dof_handler.n_dofs()};
+        pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
+              << record.mesh.dofs << " DoFs";
         if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
           pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
                 << " processes";
         pcout << std::endl;
 
-        solve();
-
+        record.solve = solve();
         {
           TimerOutput::Scope scope(computing_timer, "postprocess");
-          postprocess();
+          record.identities = postprocess();
         }
-        compute_errors();
-
-        estimate_error();
-        reconstruct_fluxes();
-        record_phase_times();
-        // The phases of the method; not the error norms (time_errors).
-        record.wall_time = record.time_setup + record.time_assembly +
-                           record.time_solve + record.time_postprocess +
-                           record.time_estimate +
-                           (record.time_flux ? *record.time_flux : 0.);
-        cumulative_time += record.wall_time;
+        record.errors    = compute_errors();
+        record.estimator = estimate_error();
+        record.flux      = reconstruct_fluxes();
+        record.times     = phase_times();
+        cumulative_time += record.times.method();
         record.cumulative_wall_time = cumulative_time;
         Utilities::System::MemoryStats memory;
         Utilities::System::get_memory_stats(memory);
         record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
         record.memory_mb =
           Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
-        pcout << "   " << record.active_set_iterations
-              << " active set iterations, " << record.active_vertices
-              << " active vertices, " << record.wall_time << " s" << std::endl;
+        pcout << "   " << record.solve.active_set_iterations
+              << " active set iterations, " << record.solve.active_vertices
+              << " active vertices, " << record.times.method() << " s"
+              << std::endl;
 
         report.add(record);
         previous_record = record;

@@ -26,49 +26,72 @@ namespace membranes
     row(const CycleRecord &r)
     {
       const bool count = true;
-      return {{"cycle", r.cycle, count},
-              {"cells", r.cells, count},
-              {"dofs", static_cast<double>(r.dofs), count},
-              {"active_set_iterations", r.active_set_iterations, count},
-              {"active_vertices", r.active_vertices, count},
-              {"wall_time_s", r.wall_time},
-              {"cumulative_wall_time_s", r.cumulative_wall_time},
-              {"err_u1_H1", r.err_u1_H1},
-              {"err_u2_H1", r.err_u2_H1},
-              {"err_u1_L2", r.err_u1_L2},
-              {"err_u2_L2", r.err_u2_L2},
-              {"err_lambda_L2", r.err_lambda_L2},
-              {"estimator", r.estimator},
-              {"effectivity", r.effectivity},
-              {"kkt_residual", r.kkt_residual},
-              {"min_w", r.min_w},
-              {"min_lambda", r.min_lambda},
-              {"prop12_defect", r.prop12_defect},
-              {"complementarity_defect", r.complementarity_defect},
-              {"linear_iterations", r.linear_iterations, count},
-              {"time_setup_s", r.time_setup},
-              {"time_assembly_s", r.time_assembly},
-              {"time_solve_s", r.time_solve},
-              {"time_postprocess_s", r.time_postprocess},
-              {"err_energy", r.err_energy},
-              {"time_estimate_s", r.time_estimate},
-              {"hanging_active_vertices", r.hanging_active_vertices, count},
-              {"flux_estimator", r.flux_estimator},
-              {"flux_effectivity", r.flux_effectivity},
-              {"measure_defect", r.measure_defect},
-              {"conservation_defect", r.conservation_defect},
-              {"balance_defect", r.balance_defect},
-              {"time_flux_s", r.time_flux},
-              {"levels", r.levels, count},
-              {"processes", r.processes, count},
-              {"memory_mb", r.memory_mb},
-              {"eta_linearization", r.linearization_estimate},
-              {"eta_algebraic", r.algebraic_estimate},
-              {"flux_estimator_flux", r.flux_estimator_flux},
-              {"flux_estimator_oscillation", r.flux_estimator_oscillation},
-              {"flux_estimator_contact", r.flux_estimator_contact},
-              {"flux_estimator_boundary", r.flux_estimator_boundary},
-              {"time_errors_s", r.time_errors}};
+      // A member of an optional record: empty where the record is.
+      const auto error = [&r](const double ErrorRecord::*norm) {
+        return r.errors ? std::optional<double>((*r.errors).*norm) :
+                          std::nullopt;
+      };
+      const auto flux = [&r](const double FluxRecord::*part) {
+        return r.flux ? std::optional<double>((*r.flux).*part) : std::nullopt;
+      };
+      const auto flux_defect =
+        [&r](const std::optional<double> FluxRecord::*defect) {
+          return r.flux ? (*r.flux).*defect : std::nullopt;
+        };
+      const auto effectivity = [&r](const std::optional<double> &estimator) {
+        return estimator && r.errors ?
+                 std::optional<double>(*estimator / r.errors->energy) :
+                 std::nullopt;
+      };
+      const std::optional<double> flux_estimator = flux(&FluxRecord::estimator);
+      const SolveRecord          &solve          = r.solve;
+      const IdentityRecord       &identities     = r.identities;
+      const TimeRecord           &times          = r.times;
+      return {
+        {"cycle", r.mesh.cycle, count},
+        {"cells", r.mesh.cells, count},
+        {"dofs", static_cast<double>(r.mesh.dofs), count},
+        {"active_set_iterations", solve.active_set_iterations, count},
+        {"active_vertices", solve.active_vertices, count},
+        {"wall_time_s", times.method()},
+        {"cumulative_wall_time_s", r.cumulative_wall_time},
+        {"err_u1_H1", error(&ErrorRecord::u1_H1)},
+        {"err_u2_H1", error(&ErrorRecord::u2_H1)},
+        {"err_u1_L2", error(&ErrorRecord::u1_L2)},
+        {"err_u2_L2", error(&ErrorRecord::u2_L2)},
+        {"err_lambda_L2", error(&ErrorRecord::lambda_L2)},
+        {"estimator", r.estimator},
+        {"effectivity", effectivity(r.estimator)},
+        {"kkt_residual", solve.kkt_residual},
+        {"min_w", identities.min_w},
+        {"min_lambda", identities.min_lambda},
+        {"prop12_defect", identities.prop12_defect},
+        {"complementarity_defect", identities.complementarity_defect},
+        {"linear_iterations", solve.linear_iterations, count},
+        {"time_setup_s", times.setup},
+        {"time_assembly_s", times.assembly},
+        {"time_solve_s", times.solve},
+        {"time_postprocess_s", times.postprocess},
+        {"err_energy", error(&ErrorRecord::energy)},
+        {"time_estimate_s", times.estimate},
+        {"hanging_active_vertices", identities.hanging_active_vertices, count},
+        {"flux_estimator", flux_estimator},
+        {"flux_effectivity", effectivity(flux_estimator)},
+        {"measure_defect", flux_defect(&FluxRecord::measure_defect)},
+        {"conservation_defect", flux_defect(&FluxRecord::conservation_defect)},
+        {"balance_defect", flux_defect(&FluxRecord::balance_defect)},
+        {"time_flux_s", times.flux},
+        {"levels", r.mesh.levels, count},
+        {"processes", r.processes, count},
+        {"memory_mb", r.memory_mb},
+        {"eta_linearization", solve.linearization_estimate},
+        {"eta_algebraic", solve.algebraic_estimate},
+        {"flux_estimator_flux", flux(&FluxRecord::flux)},
+        {"flux_estimator_oscillation", flux(&FluxRecord::oscillation)},
+        {"flux_estimator_contact", flux(&FluxRecord::contact)},
+        {"flux_estimator_boundary", flux(&FluxRecord::boundary)},
+        {"time_errors_s", times.errors},
+        {"err_lambda_L2_omega_h", error(&ErrorRecord::lambda_L2_omega_h)}};
     }
   } // namespace
 

@@ -86,17 +86,17 @@ namespace membranes
     setup_system();
     void
     transfer_solution();
-    void
+    SolveRecord
     solve();
-    void
+    IdentityRecord
     postprocess();
-    void
+    std::optional<ErrorRecord>
     compute_errors();
     bool
     computes_fluxes() const;
-    void
+    std::optional<FluxRecord>
     reconstruct_fluxes();
-    void
+    std::optional<double>
     estimate_error();
     std::string
     write_unconverged_iterate();
@@ -106,8 +106,8 @@ namespace membranes
     target_reached() const;
     void
     refine_grid();
-    void
-    record_phase_times();
+    TimeRecord
+    phase_times() const;
 
     const Parameters::All &parameters;
     MPI_Comm               mpi_communicator;

@@ -13,77 +13,115 @@ namespace membranes
 {
   using namespace dealii;
 
-  /** Everything a run records about one cycle (one row of report.csv). */
-  struct CycleRecord
+  /** The mesh of a cycle. */
+  struct MeshRecord
   {
     unsigned int cycle = 0;
     unsigned int cells = 0;
     /** Levels of the mesh hierarchy: the coarse mesh and its refinements. */
-    unsigned int            levels                = 0;
-    types::global_dof_index dofs                  = 0;
-    unsigned int            active_set_iterations = 0;
-    unsigned int            active_vertices       = 0;
-    unsigned int            linear_iterations     = 0;
-    /** Active vertices that are hanging nodes (0: the active set is on V_h). */
-    unsigned int hanging_active_vertices = 0;
-    /**
-     * Wall time of the cycle's phases of the method (not of output
-     * writing, nor of the error norms against the exact solution).
-     */
-    double wall_time = 0;
-    /** The same, summed over this and all previous cycles. */
-    double cumulative_wall_time = 0;
-    double time_setup = 0, time_assembly = 0, time_solve = 0,
-           time_postprocess = 0, time_estimate = 0;
-    /** Flux reconstruction and flux estimator; empty when not computed. */
-    std::optional<double> time_flux;
-    /**
-     * The error norms against the exact solution, a cost that a run
-     * without one never pays: not part of wall_time. Empty without an exact
-     * solution.
-     */
-    std::optional<double> time_errors;
+    unsigned int            levels = 0;
+    types::global_dof_index dofs   = 0;
+  };
 
-    /** Errors; empty when the exact solution is not known. */
-    std::optional<double> err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2,
-      err_lambda_L2;
-    /** Energy error (Σ_i μ_i |u_i − u_ih|²_{H1})^{1/2}; with the errors. */
-    std::optional<double> err_energy;
-    /** A posteriori estimator η and effectivity index η / err_energy. */
-    std::optional<double> estimator, effectivity;
-    /** The flux estimator and its effectivity, with the flux reconstruction. */
-    std::optional<double> flux_estimator, flux_effectivity;
-    /**
-     * The parts of the flux estimator (ErrorEstimator::FluxEstimate): the
-     * flux part (Σ_i η_F,i²)^{1/2}, the oscillation part (Σ_i η_R,i²)^{1/2}
-     * and the contact part (2 B)^{1/2}; with the flux estimator.
-     */
-    std::optional<double> flux_estimator_flux, flux_estimator_oscillation,
-      flux_estimator_contact;
-    /**
-     * The boundary data part (ErrorEstimator::FluxEstimate::boundary), not
-     * part of the flux estimator; with it.
-     */
-    std::optional<double> flux_estimator_boundary;
-    /**
-     * Defects of (4.17), (4.18) and of the balance of Lemma 17 (see
-     * FluxReconstruction::Identities), with the flux reconstruction.
-     */
-    std::optional<double> measure_defect, conservation_defect, balance_defect;
-
-    /** Relative KKT residual of the active set solver at the end. */
+  /** What the active set method reports at its end on one mesh. */
+  struct SolveRecord
+  {
+    unsigned int active_set_iterations = 0;
+    unsigned int active_vertices       = 0;
+    /** CG iterations, summed over the active set iterations (0: direct). */
+    unsigned int linear_iterations = 0;
+    /** Relative KKT residual at the end. */
     double kkt_residual = 0;
     /**
      * η_lin and η_alg of balanced stopping at the end (ActiveSetSolver);
      * empty with exact stopping and on the first mesh.
      */
     std::optional<double> linearization_estimate, algebraic_estimate;
+  };
+
+  /** The discrete identities of §4.1 measured on the solution. */
+  struct IdentityRecord
+  {
+    /** Active vertices that are hanging nodes (0: the active set is on V_h). */
+    unsigned int hanging_active_vertices = 0;
     /** min_a (u1h − u2h)(a) and min_a λ_a over V_h. */
     double min_w = 0, min_lambda = 0;
     /** max_a |λ_1a − λ_2a| d_a / F, F the force scale of (4.5) (Prop. 12). */
     double prop12_defect = 0;
     /** max_a |λ_a d_a (u1h − u2h)(a)| / (F max|u_h|), (4.8). */
     double complementarity_defect = 0;
+  };
+
+  /** The errors against a known exact solution, in the norms of the paper. */
+  struct ErrorRecord
+  {
+    /** The full H1(ω) norms ‖u_i − u_ih‖_{H1(ω)} of (3.5). */
+    double u1_H1 = 0, u2_H1 = 0;
+    double u1_L2 = 0, u2_L2 = 0;
+    /** ‖λ − λ_h‖_{L2(ω)} with λ_h = 0 on the strip ω ∖ ω_h, as in (4.36). */
+    double lambda_L2 = 0;
+    /** ‖λ − λ_h‖_{L2(ω_h)}: the same without the strip. */
+    double lambda_L2_omega_h = 0;
+    /** Energy error (Σ_i μ_i |u_i − u_ih|²_{H1})^{1/2} (seminorms). */
+    double energy = 0;
+  };
+
+  /** The flux estimator and the identities of the flux reconstruction. */
+  struct FluxRecord
+  {
+    /**
+     * The flux estimator and its parts (ErrorEstimator::FluxEstimate): the
+     * flux part (Σ_i η_F,i²)^{1/2}, the oscillation part (Σ_i η_R,i²)^{1/2}
+     * and the contact part (2 B)^{1/2}; the boundary data part, not part of
+     * the estimator.
+     */
+    double estimator = 0, flux = 0, oscillation = 0, contact = 0, boundary = 0;
+    /**
+     * Defects of (4.17), (4.18) and of the balance of Lemma 17 (see
+     * FluxReconstruction::Identities), with `Output/Flux reconstruction`.
+     */
+    std::optional<double> measure_defect, conservation_defect, balance_defect;
+  };
+
+  /**
+   * The wall time of each phase of a cycle. Output writing is not timed,
+   * the error norms against the exact solution on their own.
+   */
+  struct TimeRecord
+  {
+    double setup = 0, assembly = 0, solve = 0, postprocess = 0, estimate = 0;
+    /** The flux reconstruction and its estimator; where computed. */
+    std::optional<double> flux;
+    /** The error norms, a cost that a run without exact solution never pays. */
+    std::optional<double> errors;
+
+    /** The phases of the method: all but the error norms. */
+    double
+    method() const
+    {
+      return setup + assembly + solve + postprocess + estimate +
+             (flux ? *flux : 0.);
+    }
+  };
+
+  /**
+   * Everything a run records about one cycle (one row of report.csv): what
+   * each phase of the cycle returns, copied by MembraneProblem::run().
+   */
+  struct CycleRecord
+  {
+    MeshRecord     mesh;
+    SolveRecord    solve;
+    IdentityRecord identities;
+    /** Empty when the exact solution is not known. */
+    std::optional<ErrorRecord> errors;
+    /** The residual estimator η; empty when not computed. */
+    std::optional<double> estimator;
+    /** Empty when the fluxes are not reconstructed. */
+    std::optional<FluxRecord> flux;
+    TimeRecord                times;
+    /** TimeRecord::method() summed over this and all previous cycles. */
+    double cumulative_wall_time = 0;
 
     /** The number of MPI processes of the run. */
     unsigned int processes = 1;
@@ -105,7 +143,8 @@ namespace membranes
    *
    * A row is one list of (column name, value) pairs, made from a
    * CycleRecord in report.cc: adding a column is one line there (and the
-   * member of CycleRecord it reports).
+   * member of the record it reports). The effectivity indices are made
+   * there too: an estimator divided by the energy error.
    */
   class Report
   {
