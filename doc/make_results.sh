@@ -108,17 +108,25 @@ membranes_run() {
     --set "Output/Write vtu=false" "$@" "$scene" >"$work/$name.log"
 }
 
-# block DOCUMENT NAME < TABLE: the table, below the list of commands run since
-# the last block, between the markers NAME of DOCUMENT.
+# block DOCUMENT NAME < TABLE: the table between the markers NAME of
+# DOCUMENT. In README.md and benchmarks/README.md below the list of commands
+# run since the last block ("Made by"); the documents of doc/ teach and hold
+# the table alone, their commands are collected in doc_commands for the
+# block tutorial-runs of benchmarks/README.md.
+doc_commands=()
 block() {
   local document=$1 name=$2 file="$work/blocks/$2.md" line
   {
-    echo "Made by"
-    echo
-    echo '```sh'
-    for line in "${commands[@]}"; do echo "$line"; done
-    echo '```'
-    echo
+    if [[ $document == doc/* ]]; then
+      doc_commands+=("${commands[@]}")
+    else
+      echo "Made by"
+      echo
+      echo '```sh'
+      for line in "${commands[@]}"; do echo "$line"; done
+      echo '```'
+      echo
+    fi
     cat
   } >"$file"
   $python doc/results.py splice "$document" "$name" "$file"
@@ -194,7 +202,7 @@ for section in $sections; do
         >"$work/blocks/$name.table"
     done
     block doc/tutorial.md case-m-q1 <"$work/blocks/case-m-q1.table"
-    commands=("(the runs above)")
+    commands=()
     block doc/tutorial.md case-m-p1 <"$work/blocks/case-m-p1.table"
     block doc/tutorial.md full-contact <"$work/blocks/full-contact.table"
 
@@ -203,7 +211,11 @@ for section in $sections; do
       --title "Case M" "$work/case-m-q1/report.csv=Q1" \
       "$work/case-m-p1/report.csv=P1"
     figure "$work/case-m-convergence.png" case-m-convergence.png
-    echo "(the runs of case M above)" | block doc/tutorial.md case-m-figure
+    run $python source/plot_report.py --output "$work/full-contact-convergence" \
+      --title "Full contact" --columns err_lambda_L2,err_lambda_L2_omega_h \
+      "$work/full-contact/report.csv"
+    figure "$work/full-contact-convergence.png" full-contact-convergence.png
+    doc_commands+=("${commands[@]}")
 
     reports=("$work/case-m-q1/report.csv=case M, Q1"
       "$work/case-m-p1/report.csv=case M, P1"
@@ -211,7 +223,7 @@ for section in $sections; do
     commands=()
     run $python doc/results.py solver "${reports[@]}" >"$work/blocks/solver.table"
     block doc/tutorial.md solver <"$work/blocks/solver.table"
-    commands=("(the run of case-m-quadrilateral.prm above; its progress output $work/case-m-q1.log)")
+    commands=()
     $python doc/results.py terminal "$work/case-m-q1.log" 4 |
       block doc/tutorial.md terminal
     commands=()
@@ -255,12 +267,21 @@ for section in $sections; do
     run $python doc/make_figures.py "$membranes" "$work/figures" \
       >"$work/figures.log"
     mapfile -t drawn < <(sed -n 's/^\$ //p' "$work/figures.log")
-    commands+=("${drawn[@]}")
-    for image in membranes dual-mesh case-m-fields slit-adaptive-mesh; do
+    doc_commands+=("${commands[@]}" "${drawn[@]}")
+    for image in membranes dual-mesh case-m-fields slit-adaptive-mesh \
+      active-set-iterations; do
       figure "$work/figures/$image.png" "$image.png"
     done
-    echo "The figures membranes.png (from the exact solution of case M, no run), dual-mesh.png, case-m-fields.png and slit-adaptive-mesh.png." |
-      block doc/tutorial.md figures
+
+    # What made the tables and figures of doc/, in benchmarks/README.md.
+    {
+      echo '```sh'
+      for line in "${doc_commands[@]}"; do echo "$line"; done
+      echo '```'
+    } >"$work/blocks/tutorial-runs.md"
+    $python doc/results.py splice benchmarks/README.md tutorial-runs \
+      "$work/blocks/tutorial-runs.md"
+    echo "  -> benchmarks/README.md: tutorial-runs"
     ;;
 
   *)
