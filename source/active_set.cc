@@ -172,6 +172,7 @@ namespace membranes
   {
     problem         = &discrete_problem;
     active_vertices = IndexSet(discrete_problem.locally_owned_dofs().size());
+    active_flags.assign(discrete_problem.vertices().size(), false);
     predicted_action.reinit(discrete_problem);
   }
 
@@ -180,32 +181,44 @@ namespace membranes
   template <int dim>
   void
   ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem,
-                         const VectorType           &ghosted_solution,
+                         const VectorType           &solution,
                          const VectorType           &ghosted_lambda_h)
   {
     reinit(discrete_problem);
-    const double epsilon = parameters.tolerance;
-    const double u_scale = displacement_scale(ghosted_solution);
-    for (const auto &a : problem->vertices())
+    const double epsilon  = parameters.tolerance;
+    const double u_scale  = displacement_scale(solution);
+    const auto  &vertices = problem->vertices();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
       {
+        const auto  &a      = vertices[k];
         const double c      = contact_stiffness(a);
         const double lambda = ghosted_lambda_h[a.dof[0]] / (c * u_scale);
-        const double w      = nodal_w(a, ghosted_solution) / u_scale;
+        const double w      = nodal_w(k, solution) / u_scale;
         const bool   degenerate =
           std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
         if (!degenerate && lambda - w > 0)
           active_vertices.add_index(a.dof[0]);
       }
     active_vertices.compress();
+    set_flags();
   }
 
 
 
   template <int dim>
-  bool
-  ActiveSet<dim>::is_element(const types::global_dof_index dof) const
+  void
+  ActiveSet<dim>::set_flags()
   {
-    return active_vertices.is_element(dof);
+    // Both are sorted by the u1 DoF.
+    const auto &vertices = problem->vertices();
+    auto        active   = active_vertices.begin();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        active_flags[k] =
+          (active != active_vertices.end() && *active == vertices[k].dof[0]);
+        if (active_flags[k])
+          ++active;
+      }
   }
 
 
@@ -257,12 +270,14 @@ namespace membranes
   typename ActiveSet<dim>::VectorType
   ActiveSet<dim>::lambda_and_flags(const VectorType &lambda_h) const
   {
-    VectorType fields(problem->locally_owned_dofs(),
+    VectorType  fields(problem->locally_owned_dofs(),
                       problem->get_mpi_communicator());
-    for (const auto &a : problem->vertices())
+    const auto &vertices = problem->vertices();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
       {
+        const auto &a    = vertices[k];
         fields[a.dof[0]] = lambda_h[a.dof[0]];
-        fields[a.dof[1]] = is_element(a.dof[0]) ? 1 : 0;
+        fields[a.dof[1]] = is_active(k) ? 1 : 0;
       }
     fields.compress(VectorOperation::insert);
     VectorType ghosted_fields(problem->locally_owned_dofs(),
@@ -270,15 +285,6 @@ namespace membranes
                               problem->get_mpi_communicator());
     ghosted_fields = fields;
     return ghosted_fields;
-  }
-
-
-
-  template <int dim>
-  double
-  ActiveSet<dim>::nodal_w(const Vertex &a, const VectorType &solution)
-  {
-    return solution[a.dof[0]] - solution[a.dof[1]];
   }
 
 
@@ -304,7 +310,7 @@ namespace membranes
       {
         const auto  &a             = vertices[k];
         const double d             = a.dual_cell_measure;
-        const double w             = nodal_w(a, solution);
+        const double w             = nodal_w(k, solution);
         const double lambda        = action.lambda(k);
         const double contact_force = lambda * d;
         defects.sum_equilibrium =
@@ -312,7 +318,7 @@ namespace membranes
                    std::abs(action.lambda_from_membrane(0, k) -
                             action.lambda_from_membrane(1, k)) *
                      d);
-        if (!is_element(a.dof[0]))
+        if (!is_active(k))
           defects.contact_equilibrium =
             std::max(defects.contact_equilibrium, std::abs(contact_force));
         defects.min_w      = std::min(defects.min_w, w);
@@ -349,9 +355,8 @@ namespace membranes
       {
         const auto  &a = vertices[k];
         const double violation =
-          is_element(a.dof[0]) ?
-            -action.lambda(k) / (contact_stiffness(a) * u_scale) :
-            -nodal_w(a, solution) / u_scale;
+          is_active(k) ? -action.lambda(k) / (contact_stiffness(a) * u_scale) :
+                         -nodal_w(k, solution) / u_scale;
         if (violation > epsilon)
           changes.push_back({a.dof[0], violation / epsilon});
       }
@@ -390,6 +395,7 @@ namespace membranes
     static_cast<ActiveSetHistory::Step &>(update) =
       history.next(active_vertices, *next);
     active_vertices = update.active_set;
+    set_flags();
     return update;
   }
 
@@ -410,27 +416,49 @@ namespace membranes
     // Projected Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
-    // condensed Laplacian; U1 moves by μ2/M and U2 by −μ1/M of the step.
-    // The sweeps read and write the entries of the vertices (all locally
-    // owned) in the local storage of the iterate: the same arithmetic as
-    // through operator[], without a search per access.
-    VectorType    iterate = solution;
-    double *const values  = iterate.begin();
+    // condensed Laplacian. With S fixed, r_a = μ̄ (A W)_a − b_a, b the
+    // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem): one product
+    // with A on the scalar W per sweep, on contiguous local arrays. In the
+    // end U1 moves by μ2/M and U2 by −μ1/M of the change of W.
+    const double *const lifted_1 = problem->lifted_loads(0).begin();
+    const double *const lifted_2 = problem->lifted_loads(1).begin();
+    VectorType          w(problem->locally_owned_scalar_dofs(),
+                 problem->get_mpi_communicator());
+    VectorType          stiffness_w(w);
+    double *const       w_values = w.begin();
+    VectorType          iterate  = solution;
+    double *const       values   = iterate.begin();
+    for (unsigned int p = 0; p < w.locally_owned_size(); ++p)
+      w_values[p] = values[2 * p] - values[2 * p + 1];
+    const VectorType    start_w(w);
+    std::vector<double> load(vertices.size()),
+      inverse_diagonal(vertices.size());
+    std::vector<unsigned int> scalar_position(vertices.size());
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        const unsigned int p = positions[k][0] / 2;
+        scalar_position[k]   = p;
+        load[k]              = (mu2 * lifted_1[p] - mu1 * lifted_2[p]) / M;
+        inverse_diagonal[k] =
+          2 / (data.mu_bar * vertices[k].stiffness_row_l1_norm);
+      }
+    const double *const product = stiffness_w.begin();
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
-        predicted_action.compute(iterate);
+        problem->laplace_matrix().vmult(stiffness_w, w);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
-            const auto  &a = vertices[k];
-            const double w = values[positions[k][0]] - values[positions[k][1]];
-            const double r = predicted_action.lambda(k) * a.dual_cell_measure;
-            const double step =
-              std::max(0.,
-                       w - 2 * r / (data.mu_bar * a.stiffness_row_l1_norm)) -
-              w;
-            values[positions[k][0]] += mu2 / M * step;
-            values[positions[k][1]] -= mu1 / M * step;
+            const unsigned int p = scalar_position[k];
+            const double       r = data.mu_bar * product[p] - load[k];
+            w_values[p] = std::max(0., w_values[p] - r * inverse_diagonal[k]);
           }
+      }
+    const double *const start = start_w.begin();
+    for (unsigned int p = 0; p < w.locally_owned_size(); ++p)
+      {
+        const double step = w_values[p] - start[p];
+        values[2 * p] += mu2 / M * step;
+        values[2 * p + 1] -= mu1 / M * step;
       }
     predicted_action.compute(iterate);
 
@@ -442,9 +470,9 @@ namespace membranes
         const auto  &a = vertices[k];
         const double c = contact_stiffness(a);
         const double test =
-          (predicted_action.lambda(k) - c * nodal_w(a, iterate)) /
+          (predicted_action.lambda(k) - c * nodal_w(k, iterate)) /
           (c * u_scale);
-        const double violation = is_element(a.dof[0]) ? -test : test;
+        const double violation = is_active(k) ? -test : test;
         if (violation > epsilon)
           changes.push_back({a.dof[0], violation / epsilon});
         else if (std::abs(test) <= epsilon)

@@ -248,10 +248,8 @@ namespace membranes
   void
   ActiveSetSolver<dim>::compute_action(DiscreteAction<dim> &action,
                                        const VectorType    &solution,
-                                       VectorType          &ghosted_solution,
                                        StoppingState       &stopping) const
   {
-    ghosted_solution = solution;
     action.compute(solution);
     stopping.force_scales = {
       {action.force_scale(), action.contact_force_scale()}};
@@ -295,7 +293,7 @@ namespace membranes
     const double d  = a.dual_cell_measure;
     const double r1 = action.lambda_from_membrane(0, k) * d;
     const double r2 = action.lambda_from_membrane(1, k) * d;
-    if (active_set.is_element(a.dof[0]))
+    if (active_set.is_active(k))
       return weights[2] * (r1 - r2) * (r1 - r2);
     return weights[0] * r1 * r1 + weights[1] * r2 * r2;
   }
@@ -315,11 +313,10 @@ namespace membranes
       {
         const auto  &a    = vertices[k];
         const double norm = a.stiffness_row_l1_norm;
-        const double step =
-          active_set.is_element(a.dof[0]) ?
-            2 * std::max(-action.lambda(k), 0.) * a.dual_cell_measure /
-              (data.mu_bar * norm) :
-            std::max(-ActiveSet<dim>::nodal_w(a, solution), 0.);
+        const double step = active_set.is_active(k) ?
+                              2 * std::max(-action.lambda(k), 0.) *
+                                a.dual_cell_measure / (data.mu_bar * norm) :
+                              std::max(-active_set.nodal_w(k, solution), 0.);
         energy += data.mu_bar * norm * step * step;
       }
     return std::sqrt(Utilities::MPI::sum(energy, mpi_communicator));
@@ -357,9 +354,6 @@ namespace membranes
   {
     Statistics    statistics;
     StoppingState stopping = start(expected_error);
-    VectorType    ghosted_solution(problem->locally_owned_dofs(),
-                                problem->locally_relevant_dofs(),
-                                mpi_communicator);
     active_set.restart();
     for (statistics.iterations = 1;; ++statistics.iterations)
       {
@@ -372,15 +366,14 @@ namespace membranes
         // The forces of the initial guess set the tolerances of the first
         // linear solve.
         if (statistics.iterations == 1)
-          compute_action(action, solution, ghosted_solution, stopping);
+          compute_action(action, solution, stopping);
         system->solve(solution, linear_tolerances(stopping), statistics);
-        compute_action(action, solution, ghosted_solution, stopping);
-        const auto changes =
-          active_set.wanted_changes(action, ghosted_solution);
+        compute_action(action, solution, stopping);
+        const auto changes = active_set.wanted_changes(action, solution);
         const auto n_changes =
           Utilities::MPI::sum<types::global_dof_index>(changes.size(),
                                                        mpi_communicator);
-        evaluate(action, ghosted_solution, active_set, stopping, statistics);
+        evaluate(action, solution, active_set, stopping, statistics);
         print_iteration(
           statistics, active_set, n_changes, linear_iterations, stopping);
         if (stops(statistics, n_changes, stopping))

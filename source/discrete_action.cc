@@ -63,17 +63,32 @@ namespace membranes
     // error of forces of tension μ̄.
     // In the same pass, λ_a of both formulas, which the active set method
     // reads many times per iteration.
-    const auto  &vertices = problem->vertices();
+    // The terms are those of stiffness_term() and load_term(), read from
+    // the local storage of the vectors.
+    const auto  &vertices  = problem->vertices();
+    const auto  &positions = problem->local_positions();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
+    std::array<const double *, 2> products, load_values, lifted_values;
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        products[i]      = stiffness_products[i].begin();
+        load_values[i]   = problem->loads(i).begin();
+        lifted_values[i] = problem->lifted_loads(i).begin();
+      }
     membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const Vertex               &a = vertices[k];
-        const std::array<double, 2> stiffness{
-          {stiffness_term(0, k), stiffness_term(1, k)}};
-        const std::array<double, 2> loads{{load_term(0, k), load_term(1, k)}};
-        const auto                 &position = problem->local_positions()[k];
+        const Vertex         &a        = vertices[k];
+        const auto           &position = positions[k];
+        const unsigned int    p        = position[0] / 2;
+        std::array<double, 2> stiffness, loads;
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            loads[i]     = load_values[i][p];
+            stiffness[i] = data.mu[i] * products[i][p] +
+                           (load_values[i][p] - lifted_values[i][p]);
+          }
         for (unsigned int i = 0; i < 2; ++i)
           membrane_lambdas[k][i] = (i == 0 ? 1. : -1.) *
                                    (stiffness[i] - loads[i]) /
@@ -220,7 +235,9 @@ namespace membranes
     const unsigned int                                    v,
     const VectorType                                     &lambda_h) const
   {
-    return lambda_h_at_vertex(cell->vertex_dof_index(v, 0), lambda_h);
+    return problem->is_interior_vertex(cell, v) ?
+             lambda_h[cell->vertex_dof_index(v, 0)] :
+             0.;
   }
 
 
@@ -249,9 +266,8 @@ namespace membranes
     std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
     for (const unsigned int v : cell->vertex_indices())
       {
-        vertex_values[v] = lambda_h_value(cell, v, lambda_h);
-        vertex_in_omega_h[v] =
-          problem->is_interior_vertex(cell->vertex_dof_index(v, 0));
+        vertex_values[v]     = lambda_h_value(cell, v, lambda_h);
+        vertex_in_omega_h[v] = problem->is_interior_vertex(cell, v);
       }
     values.resize(dual_cell_quadrature.quadrature().size());
     if (in_omega_h)

@@ -247,19 +247,26 @@ namespace membranes
     const VectorType                &dual_cell_measure,
     const VectorType                &stiffness_diagonal)
   {
-    // The interior vertices of the owned and ghost cells, each once, by
-    // their DoFs (u1, u2).
+    // The interior vertices of the owned and ghost cells, each once (by
+    // its index in the mesh), by their DoFs (u1, u2).
     const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
+    const auto    &triangulation = dof_handler.get_triangulation();
+    std::vector<char> seen(triangulation.n_vertices(), false);
+    interior_vertex_flags.assign(triangulation.n_vertices(), false);
     std::vector<std::array<types::global_dof_index, 2>> candidates;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         for (const unsigned int v : cell->vertex_indices())
-          if (!boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
-            candidates.push_back(
-              {{cell->vertex_dof_index(v, 0), cell->vertex_dof_index(v, 1)}});
+          if (!seen[cell->vertex_index(v)])
+            {
+              seen[cell->vertex_index(v)] = true;
+              if (boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
+                continue;
+              interior_vertex_flags[cell->vertex_index(v)] = true;
+              candidates.push_back(
+                {{cell->vertex_dof_index(v, 0), cell->vertex_dof_index(v, 1)}});
+            }
     std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()),
-                     candidates.end());
 
     // The l1 norms of the locally owned rows of A, by Epetra's own row sums
     // of absolute values (deal.II's row iterator of a Trilinos matrix

@@ -251,7 +251,7 @@ namespace membranes
     solution         = interpolated[0];
     ghosted_solution = interpolated[0];
     lambda_h         = interpolated[1];
-    active_set.reinit(discrete_problem, ghosted_solution, lambda_h);
+    active_set.reinit(discrete_problem, solution, lambda_h);
   }
 
 

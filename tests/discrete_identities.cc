@@ -363,10 +363,9 @@ namespace
     // (4.8) with λ_a > 0: fails if the contact constraint u1h(a) = u2h(a)
     // is not imposed (or the vertex is left inactive) where λ_a > 0.
     check_true(name + ": the vertex is active",
-               problem.active_set.is_element(a.dof[0]));
+               problem.active_set.is_active(k));
     check(name + ": (4.8) lambda_a (u1h - u2h)(a)",
-          action.lambda(k) *
-            ActiveSet<dim>::nodal_w(a, problem.ghosted_solution),
+          action.lambda(k) * problem.active_set.nodal_w(k, problem.solution),
           0,
           lambda_contact * std::abs(u));
   }
@@ -443,7 +442,7 @@ namespace
     const auto        &b  = apart.discrete_problem.vertices()[ka];
     // A vertex kept in contact where the membranes separate.
     check_true("Q1 2x2, apart: vertex a is inactive",
-               !apart.active_set.is_element(b.dof[0]));
+               !apart.active_set.is_active(ka));
     check("Q1 2x2, apart: u1h(a)", apart.ghosted_solution[b.dof[0]], 3. / 16.);
     check("Q1 2x2, apart: u2h(a)", apart.ghosted_solution[b.dof[1]], -3. / 64.);
     // λ_a = 0 off contact, from both formulas (the scale: f1 = 2).
@@ -457,7 +456,7 @@ namespace
           2.);
     check("Q1 2x2, apart: (4.8) lambda_a (u1h - u2h)(a)",
           apart.action.lambda(ka) *
-            ActiveSet<dim>::nodal_w(b, apart.ghosted_solution),
+            apart.active_set.nodal_w(ka, apart.solution),
           0,
           2. * 15. / 64.);
   }

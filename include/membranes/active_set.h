@@ -181,8 +181,8 @@ namespace membranes
    * initial value on a new mesh, its update from an iterate, and the
    * constraint lines it imposes.
    *
-   * With W_a = u1h(a) − u2h(a) (nodal_w()) and the nodal multiplier Λ_a = λ_a
-   * of (4.5), the active set is
+   * With W_a = u1h(a) − u2h(a) (ActiveSet::nodal_w()) and the nodal multiplier
+   * Λ_a = λ_a of (4.5), the active set is
    *
    *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a
    *
@@ -282,18 +282,23 @@ namespace membranes
 
     /**
      * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
-     * mesh's solution and λ_h interpolated onto it (nested iteration). A
+     * mesh's solution (@p solution, the locally owned DoFs) and λ_h
+     * interpolated onto it (nested iteration). A
      * vertex where both |λ̂_a| ≤ ε and |Ŵ_a| ≤ ε is degenerate up to
      * round-off; it starts inactive, as every vertex of the first mesh does.
      */
     void
     reinit(const DiscreteProblem<dim> &discrete_problem,
-           const VectorType           &ghosted_solution,
+           const VectorType           &solution,
            const VectorType           &ghosted_lambda_h);
 
-    /** Whether the vertex with u1 DoF @p dof (locally owned) is active. */
+    /** Whether the locally owned vertex k of DiscreteProblem::vertices() is
+     * active. */
     bool
-    is_element(const types::global_dof_index dof) const;
+    is_active(const unsigned int k) const
+    {
+      return active_flags[k];
+    }
 
     /** The locally owned active vertices (u1 DoFs). */
     const IndexSet &
@@ -321,23 +326,36 @@ namespace membranes
     VectorType
     lambda_and_flags(const VectorType &lambda_h) const;
 
-    /** W_a = u1h(a) − u2h(a) of @p solution (a locally owned). */
-    static double
-    nodal_w(const Vertex &a, const VectorType &solution);
+    /**
+     * W_a = u1h(a) − u2h(a) at the locally owned vertex k of
+     * DiscreteProblem::vertices(), read from the local storage of
+     * @p solution (a vector of the locally owned DoFs) at the positions of
+     * the vertex: no search per entry.
+     */
+    double
+    nodal_w(const unsigned int k, const VectorType &solution) const
+    {
+      const double *const values   = solution.begin();
+      const auto         &position = problem->local_positions()[k];
+      return values[position[0]] - values[position[1]];
+    }
 
     /** c_a = μ̄ ∫|∇φ_a|² / d_a. */
     double
     contact_stiffness(const Vertex &a) const;
 
-    /** The KKT defects of the iterate @p solution with λ_a in @p action. */
+    /**
+     * The KKT defects of the iterate @p solution (locally owned DoFs) with
+     * λ_a in @p action.
+     */
     KKTDefects
     kkt_defects(const DiscreteAction<dim> &action,
                 const VectorType          &solution) const;
 
     /**
      * The locally owned vertices whose status the test wants to change on
-     * the iterate @p solution, with λ_a in @p action, outside the band of
-     * indifference, by increasing DoF.
+     * the iterate @p solution (locally owned DoFs), with λ_a in @p action,
+     * outside the band of indifference, by increasing DoF.
      */
     std::vector<StatusChange>
     wanted_changes(const DiscreteAction<dim> &action,
@@ -392,9 +410,18 @@ namespace membranes
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
 
+    /** active_flags from active_vertices, in one pass over both. */
+    void
+    set_flags();
+
     const DiscreteProblem<dim> *problem;
     /** The locally owned active vertices. */
     IndexSet active_vertices;
+    /**
+     * The same as one flag per locally owned vertex of V_h, in the order of
+     * DiscreteProblem::vertices(): what the loops over the vertices read.
+     */
+    std::vector<char> active_flags;
     /** The sets visited on this mesh. */
     ActiveSetHistory history;
     /** λ_a of the predicted iterate (not that of the iterate itself). */

@@ -231,13 +231,12 @@ namespace membranes
     start(const double expected_error) const;
 
     /**
-     * λ_a of the iterate @p solution into @p action, @p solution into
-     * @p ghosted_solution, and its force scales into @p stopping.
+     * λ_a of the iterate @p solution into @p action, and its force scales
+     * into @p stopping.
      */
     void
     compute_action(DiscreteAction<dim> &action,
                    const VectorType    &solution,
-                   VectorType          &ghosted_solution,
                    StoppingState       &stopping) const;
 
     /**

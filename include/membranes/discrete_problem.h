@@ -193,6 +193,18 @@ namespace membranes
     bool
     is_interior_vertex(const types::global_dof_index a) const;
 
+    /**
+     * The same for vertex @p v of the locally relevant @p cell, by the
+     * vertex's index in the mesh: no search (the loops over the cells).
+     */
+    bool
+    is_interior_vertex(
+      const typename DoFHandler<dim>::active_cell_iterator &cell,
+      const unsigned int                                    v) const
+    {
+      return interior_vertex_flags[cell->vertex_index(v)];
+    }
+
   private:
     /**
      * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
@@ -237,6 +249,8 @@ namespace membranes
     std::vector<std::array<int, 2>>                     positions;
     std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
     IndexSet                                            interior_vertex_dofs;
+    /** is_interior_vertex() by the index of the vertex in the mesh. */
+    std::vector<char> interior_vertex_flags;
   };
 } // namespace membranes
 
