@@ -35,12 +35,15 @@ levels=${LEVELS:-7}
 peer=$root/benchmarks/peer_snesvi.py
 # The interpreter of Debian's python3-dolfinx.
 python=/usr/bin/python3
-# SCENE=degenerate (default) or shifted-circle; EVALUATION=auto (default),
-# compiled or parser: membranes' Problem/Expression evaluation. With the
-# parser, the degenerate scene is tests/scenes/degenerate-free-boundary-
-# loads.prm (its data written out). The shifted circle is always
+# SCENE=degenerate (default), shifted-circle or ellipse; EVALUATION=auto
+# (default), compiled or parser: membranes' Problem/Expression evaluation.
+# With the parser, the degenerate scene is tests/scenes/degenerate-free-
+# boundary-loads.prm (its data written out). The shifted circle is always
 # tests/scenes/shifted-circle-loads.prm (long expressions as written by hand,
-# mu1 = 1, mu2 = 2).
+# mu1 = 1, mu2 = 2). The ellipse is tests/scenes/ellipse-contact.prm: contact
+# inside an ellipse off the centre, u2 = sin(pi x) sin(pi y), a cubic gap
+# and an action vanishing quadratically at the free boundary (data written
+# out, mu1 = mu2 = 1).
 peer_scene=${SCENE:-degenerate}
 evaluation=${EVALUATION:-auto}
 case $peer_scene in
@@ -52,8 +55,11 @@ case $peer_scene in
   shifted-circle)
     scene=$root/tests/scenes/shifted-circle-loads.prm
     tensions=(--mu1 1 --mu2 2) ;;
+  ellipse)
+    scene=$root/tests/scenes/ellipse-contact.prm
+    tensions=(--mu1 1 --mu2 1) ;;
   *)
-    echo "peer_snesvi.sh: error: SCENE=$peer_scene is not degenerate or shifted-circle" >&2
+    echo "peer_snesvi.sh: error: SCENE=$peer_scene is not degenerate, shifted-circle or ellipse" >&2
     exit 1 ;;
 esac
 
