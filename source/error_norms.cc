@@ -23,16 +23,8 @@ namespace membranes
                            const VectorType          &lambda_h,
                            const MPI_Comm             mpi_communicator) const
   {
-    // All six norms in one pass over the cells, at the points of the
-    // dual-cell quadrature, which λ_h needs: one call of the exact solution
-    // (ProblemData::exact_solution_list(), compiled) gives u1, u2, their
-    // gradients and λ together. VectorTools::integrate_difference() takes
-    // one pass and one evaluation of the exact solution per norm and
-    // membrane; measured on case M (5.3·10⁵ DoFs), its four passes and this
-    // one for λ took 4.4 times as long (2.40 against 0.55 s on Q1, 4.50
-    // against 1.02 s on P1; 4.3 times on one thread), and with QGauss(2)
-    // its L2 errors came out 2 to 6 % low (the Gauss points are where the
-    // error of a bilinear interpolant is smallest).
+    // All six norms in one pass over the cells (see the class comment for
+    // why not VectorTools::integrate_difference()).
     //
     // What one thread needs on a cell: u_h, λ_h, u, λ and the gradients
     // at the points of the dual-cell quadrature.

@@ -25,7 +25,15 @@ namespace membranes
    * All integrals use the DualCellQuadrature of DiscreteAction, so
    * that each quadrature point knows the dual cell D_a it lies in and λ_h
    * is evaluated exactly; the same rule integrates the displacement errors
-   * over the whole cell.
+   * over the whole cell, in one pass: one call of the exact solution
+   * (ProblemData::exact_solution_list(), compiled) gives u1, u2, their
+   * gradients and λ together. VectorTools::integrate_difference() takes
+   * one pass and one evaluation of the exact solution per norm and
+   * membrane; measured on case M (5.3·10⁵ DoFs), its four passes and one
+   * for λ took 4.4 times as long (2.40 against 0.55 s on Q1, 4.50 against
+   * 1.02 s on P1; 4.3 times on one thread), and with QGauss(2) its L2
+   * errors came out 2 to 6 % low (the Gauss points are where the error of
+   * a bilinear interpolant is smallest).
    */
   template <int dim>
   class ErrorNorms
