@@ -2,22 +2,37 @@
  * The floor of the setup of one cycle of case M, measured with deal.II's
  * building blocks alone.
  *
- *   setup_floor [refinements] [components|full] [trim]
+ *   setup_floor [quadrilateral|triangle] [refinements] [components|full]
+ *               [trim]
  *
  * One cycle of the active set method on a new mesh needs, before its first
  * linear solve: the refined mesh with the previous solution carried over
  * to it, the DoFs, the constraints, and the matrix and right-hand side of
  * the linear system. This program does exactly that and nothing more, in
- * the way membranes does it (the same triangulation, mapping, element,
- * quadrature, constraints, sparsity pattern, matrix type and AMG
- * settings), and times each step. The linear solve that follows, one
- * CG-AMG solve of the coupled (u1, u2) system without contact, is the
- * yardstick of benchmarks/solver_cost.sh: the ratio of the two says how
- * much of the setup no implementation on these building blocks can save.
+ * the way membranes does it on the cell type (the same triangulation,
+ * mapping, element, quadrature, solution transfer, constraints, sparsity
+ * pattern, matrix type and AMG settings), and times each step. The linear
+ * solve that follows, one CG-AMG solve of the coupled (u1, u2) system
+ * without contact, is the yardstick of benchmarks/solver_cost.sh: the
+ * ratio of the two says how much of the setup no implementation on these
+ * building blocks can save.
  *
- * The mesh of case M (the square (-1,1)², global refinement) is refined
- * @p refinements times (default 9: 512 × 512 cells) and solved on, as the
- * previous cycle; the measured cycle is the next one (1024 × 1024 cells).
+ * The mesh of case M is the square (-1,1)² under global refinement. With
+ * `quadrilateral` (the default) it lives in a
+ * parallel::distributed::Triangulation (p4est), with MappingCartesian,
+ * FE_Q(1), QGauss(3), and the solution goes to the new mesh by
+ * parallel::distributed::SolutionTransfer; it is refined @p refinements
+ * times (default 9: 512 × 512 cells) and solved on, as the previous
+ * cycle, and the measured cycle is the next one (1024 × 1024 cells). With
+ * `triangle` the square is split into 8 triangles, as membranes splits
+ * it for `Cell type = triangle`, in a parallel::shared::Triangulation
+ * (every process holds the whole mesh, partitioned in z-order), with
+ * MappingFE(FE_SimplexP(1)), FE_SimplexP(1), QGaussSimplex(3), and the
+ * serial SolutionTransfer of vectors with every entry, which membranes
+ * uses where p4est cannot hold the mesh; the default of 7 refinements
+ * makes the measured cycle go from 131 072 to 524 288 triangles, the last
+ * cycle of parameters/degenerate-free-boundary.prm.
+ *
  * After each step the program reads the peak resident set size (VmHWM) and
  * the current one (VmRSS) of the process. With `trim`, the memory freed in
  * a step goes back to the system first (glibc's malloc_trim), so that the
@@ -40,14 +55,17 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/utilities.h>
+#include <deal.II/distributed/shared_tria.h>
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_cartesian.h>
+#include <deal.II/fe/mapping_fe.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
@@ -58,6 +76,8 @@
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/lac/vector.h>
+#include <deal.II/numerics/solution_transfer.h>
 #include <deal.II/numerics/vector_tools.h>
 #include <iomanip>
 #include <iostream>
@@ -133,6 +153,85 @@ namespace setup_floor
 
 
 
+  /**
+   * The triangulation that membranes makes for the cell type: on
+   * quadrilaterals p4est's, on triangles (@p triangles), which p4est cannot
+   * hold, one that every process holds whole.
+   */
+  std::unique_ptr<Triangulation<dim>>
+  make_triangulation(const bool triangles, const MPI_Comm mpi_communicator)
+  {
+    if (!triangles)
+      return std::make_unique<parallel::distributed::Triangulation<dim>>(
+        mpi_communicator);
+    return std::make_unique<parallel::shared::Triangulation<dim>>(
+      mpi_communicator,
+      Triangulation<dim>::none,
+      /* allow_artificial_cells = */ true,
+      parallel::shared::Triangulation<dim>::partition_zorder);
+  }
+
+
+
+  /**
+   * The square (-1,1)², with @p triangles split into 8 triangles as
+   * membranes splits it (convert_hypercube_to_simplex_mesh of a serial
+   * mesh), in @p triangulation, refined @p refinements times.
+   */
+  void
+  make_mesh(const bool          triangles,
+            const unsigned int  refinements,
+            Triangulation<dim> &triangulation)
+  {
+    if (triangles)
+      {
+        Triangulation<dim> square;
+        GridGenerator::hyper_cube(square, -1, 1);
+        GridGenerator::convert_hypercube_to_simplex_mesh(square, triangulation);
+      }
+    else
+      GridGenerator::hyper_cube(triangulation, -1, 1);
+    triangulation.refine_global(refinements);
+  }
+
+
+
+  /** The element of one component: linear on the cell type. */
+  std::unique_ptr<FiniteElement<dim>>
+  make_scalar_element(const bool triangles)
+  {
+    if (triangles)
+      return std::make_unique<FE_SimplexP<dim>>(1);
+    return std::make_unique<FE_Q<dim>>(1);
+  }
+
+
+
+  /**
+   * The mapping of membranes' Discretization: on triangles the linear one
+   * of simplices, on the axis-parallel squares of case M the Cartesian one.
+   */
+  std::unique_ptr<Mapping<dim>>
+  make_mapping(const bool triangles)
+  {
+    if (triangles)
+      return std::make_unique<MappingFE<dim>>(FE_SimplexP<dim>(1));
+    return std::make_unique<MappingCartesian<dim>>();
+  }
+
+
+
+  /** The cell quadrature of membranes' Discretization. */
+  Quadrature<dim>
+  make_quadrature(const bool triangles)
+  {
+    if (triangles)
+      return QGaussSimplex<dim>(3);
+    return QGauss<dim>(3);
+  }
+
+
+
   /** One timed step: its wall time and the memory of the process after it. */
   struct Step
   {
@@ -148,7 +247,8 @@ namespace setup_floor
   class SetupFloor
   {
   public:
-    SetupFloor(const unsigned int refinements,
+    SetupFloor(const bool         triangles,
+               const unsigned int refinements,
                const bool         full_coupling,
                const bool         trim_memory);
 
@@ -191,14 +291,15 @@ namespace setup_floor
     print_table(const double       refinement_alone,
                 const unsigned int cg_iterations) const;
 
+    const bool                                triangles;
     const unsigned int                        refinements;
     const bool                                full_coupling;
     const bool                                trim_memory;
     MPI_Comm                                  mpi_communicator;
-    parallel::distributed::Triangulation<dim> triangulation;
+    const std::unique_ptr<Triangulation<dim>> triangulation;
     const FESystem<dim>                       fe;
-    const MappingCartesian<dim>               mapping;
-    const QGauss<dim>                         quadrature;
+    const std::unique_ptr<const Mapping<dim>> mapping;
+    const Quadrature<dim>                     quadrature;
     DoFHandler<dim>                           dof_handler;
 
     IndexSet                          locally_owned_dofs;
@@ -210,30 +311,37 @@ namespace setup_floor
     TrilinosWrappers::PreconditionAMG amg;
 
     // The solution x and a second vector of the same layout, which stands
-    // in for λ_h (membranes carries both to the next mesh); their ghosted
-    // copies on the previous mesh while the transfer holds them.
-    VectorType              solution;
-    VectorType              lambda_h;
-    std::vector<VectorType> previous_vectors;
+    // in for λ_h (membranes carries both to the next mesh); their copies on
+    // the previous mesh while a transfer holds them: ghosted ones for the
+    // transfer of p4est's mesh, ones with every entry for the serial
+    // transfer of triangles.
+    VectorType                  solution;
+    VectorType                  lambda_h;
+    std::vector<VectorType>     previous_vectors;
+    std::vector<Vector<double>> replicated_previous_vectors;
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>>
-      transfer;
+                                                           distributed_transfer;
+    std::unique_ptr<SolutionTransfer<dim, Vector<double>>> serial_transfer;
 
     std::vector<Step> steps;
   };
 
 
 
-  SetupFloor::SetupFloor(const unsigned int refinements,
+  SetupFloor::SetupFloor(const bool         triangles,
+                         const unsigned int refinements,
                          const bool         full_coupling,
                          const bool         trim_memory)
-    : refinements(refinements)
+    : triangles(triangles)
+    , refinements(refinements)
     , full_coupling(full_coupling)
     , trim_memory(trim_memory)
     , mpi_communicator(MPI_COMM_WORLD)
-    , triangulation(mpi_communicator)
-    , fe(FE_Q<dim>(1), 2)
-    , quadrature(3)
-    , dof_handler(triangulation)
+    , triangulation(make_triangulation(triangles, mpi_communicator))
+    , fe(*make_scalar_element(triangles), 2)
+    , mapping(make_mapping(triangles))
+    , quadrature(make_quadrature(triangles))
+    , dof_handler(*triangulation)
   {}
 
 
@@ -268,17 +376,16 @@ namespace setup_floor
 
 
   /**
-   * The cycle: the previous mesh (512 × 512 cells by default) is set up and
-   * solved on untimed, from a zero start; then the next mesh is made from
-   * it and set up step by step, and solved on once. Last, the refinement
-   * of the previous mesh is timed on its own.
+   * The cycle: the previous mesh is set up and solved on untimed, from a
+   * zero start; then the next mesh is made from it and set up step by
+   * step, and solved on once. Last, the refinement of the previous mesh is
+   * timed on its own.
    */
   void
   SetupFloor::run()
   {
     timed("0. the process at start (the libraries)", true, []() {});
-    GridGenerator::hyper_cube(triangulation, -1, 1);
-    triangulation.refine_global(refinements);
+    make_mesh(triangles, refinements, *triangulation);
     distribute_dofs();
     solution.reinit(locally_owned_dofs, mpi_communicator);
     make_constraints();
@@ -290,12 +397,17 @@ namespace setup_floor
     clear_system();
     timed("0. the previous mesh solved on, its system freed", true, []() {});
 
-    timed("1a. refine flags; the two vectors to the transfer", true, [&]() {
-      prepare_transfer();
-    });
-    timed("1b. refinement, the vectors packed on the way", true, [&]() {
-      triangulation.execute_coarsening_and_refinement();
-    });
+    // The serial transfer of triangles notes the DoF indices of each cell
+    // when it is handed the vectors; the refinement packs nothing.
+    timed(triangles ? "1a. refine flags; the two vectors, whole, to the "
+                      "transfer" :
+                      "1a. refine flags; the two vectors to the transfer",
+          true,
+          [&]() { prepare_transfer(); });
+    timed(triangles ? "1b. refinement" :
+                      "1b. refinement, the vectors packed on the way",
+          true,
+          [&]() { triangulation->execute_coarsening_and_refinement(); });
     timed("2. distribute_dofs, owned DoFs", true, [&]() { distribute_dofs(); });
     timed("1c. interpolation of the two vectors", true, [&]() {
       interpolate_previous_solution();
@@ -329,11 +441,11 @@ namespace setup_floor
   double
   SetupFloor::time_refinement_alone() const
   {
-    parallel::distributed::Triangulation<dim> mesh(mpi_communicator);
-    GridGenerator::hyper_cube(mesh, -1, 1);
-    mesh.refine_global(refinements);
+    const std::unique_ptr<Triangulation<dim>> mesh =
+      make_triangulation(triangles, mpi_communicator);
+    make_mesh(triangles, refinements, *mesh);
     const auto start = std::chrono::steady_clock::now();
-    mesh.refine_global(1);
+    mesh->refine_global(1);
     const std::chrono::duration<double> seconds =
       std::chrono::steady_clock::now() - start;
     return seconds.count();
@@ -343,24 +455,37 @@ namespace setup_floor
 
   /**
    * Global refinement as membranes::MembraneProblem::refine_grid() does it:
-   * every cell flagged, and the solution and λ_h, copied into vectors with
-   * ghost entries, handed to a SolutionTransfer, which packs them into the
-   * refinement's data.
+   * every cell flagged, and the solution and λ_h handed to a
+   * SolutionTransfer. On p4est's mesh they are copied into vectors with
+   * ghost entries, which the transfer packs into the refinement's data; on
+   * triangles, into vectors with every entry (the copy gathers them), from
+   * which the serial transfer reads each cell's values when it
+   * interpolates.
    */
   void
   SetupFloor::prepare_transfer()
   {
-    triangulation.set_all_refine_flags();
-    triangulation.prepare_coarsening_and_refinement();
+    triangulation->set_all_refine_flags();
+    triangulation->prepare_coarsening_and_refinement();
+    if (triangles)
+      {
+        replicated_previous_vectors = {Vector<double>(solution),
+                                       Vector<double>(lambda_h)};
+        serial_transfer =
+          std::make_unique<SolutionTransfer<dim, Vector<double>>>(dof_handler);
+        serial_transfer->prepare_for_coarsening_and_refinement(
+          replicated_previous_vectors);
+        return;
+      }
     previous_vectors.assign(2,
                             VectorType(locally_owned_dofs,
                                        locally_relevant_dofs,
                                        mpi_communicator));
-    previous_vectors[0] = solution;
-    previous_vectors[1] = lambda_h;
-    transfer            = std::make_unique<
+    previous_vectors[0]  = solution;
+    previous_vectors[1]  = lambda_h;
+    distributed_transfer = std::make_unique<
       parallel::distributed::SolutionTransfer<dim, VectorType>>(dof_handler);
-    transfer->prepare_for_coarsening_and_refinement(
+    distributed_transfer->prepare_for_coarsening_and_refinement(
       {&previous_vectors[0], &previous_vectors[1]});
   }
 
@@ -377,17 +502,38 @@ namespace setup_floor
 
 
 
-  /** The previous solution and λ_h on the new mesh: the initial guess. */
+  /**
+   * The previous solution and λ_h on the new mesh: the initial guess. The
+   * serial transfer interpolates on every cell, into vectors with every
+   * entry, of which the locally owned ones are copied.
+   */
   void
   SetupFloor::interpolate_previous_solution()
   {
-    std::vector<VectorType>   interpolated(2,
+    std::vector<VectorType> interpolated(2,
                                          VectorType(locally_owned_dofs,
                                                     mpi_communicator));
-    std::vector<VectorType *> targets{&interpolated[0], &interpolated[1]};
-    transfer->interpolate(targets);
-    transfer.reset();
+    if (triangles)
+      {
+        std::vector<Vector<double>> replicated(
+          2, Vector<double>(dof_handler.n_dofs()));
+        serial_transfer->interpolate(replicated_previous_vectors, replicated);
+        for (unsigned int v = 0; v < 2; ++v)
+          {
+            for (const auto i : locally_owned_dofs)
+              interpolated[v][i] = replicated[v][i];
+            interpolated[v].compress(VectorOperation::insert);
+          }
+      }
+    else
+      {
+        std::vector<VectorType *> targets{&interpolated[0], &interpolated[1]};
+        distributed_transfer->interpolate(targets);
+      }
+    distributed_transfer.reset();
+    serial_transfer.reset();
     previous_vectors.clear();
+    replicated_previous_vectors.clear();
     solution.swap(interpolated[0]);
     lambda_h.swap(interpolated[1]);
   }
@@ -408,7 +554,7 @@ namespace setup_floor
     constraints.reinit(locally_relevant_dofs);
     DoFTools::make_hanging_node_constraints(dof_handler, constraints);
     VectorTools::interpolate_boundary_values(
-      mapping, dof_handler, 0, ScaledBoundaryValues(), constraints);
+      *mapping, dof_handler, 0, ScaledBoundaryValues(), constraints);
     constraints.close();
     DoFTools::extract_constant_modes(dof_handler,
                                      ComponentMask(),
@@ -459,7 +605,7 @@ namespace setup_floor
   SetupFloor::assemble()
   {
     const FiniteElement<dim> &scalar = fe.base_element(0);
-    FEValues<dim>             fe_values(mapping,
+    FEValues<dim>             fe_values(*mapping,
                             scalar,
                             quadrature,
                             update_values | update_gradients |
@@ -606,7 +752,8 @@ namespace setup_floor
     };
     std::cout << (full_coupling ? "full" : "components") << " coupling, "
               << (trim_memory ? "freed memory trimmed, " : "")
-              << triangulation.n_global_active_cells() << " cells, "
+              << triangulation->n_global_active_cells()
+              << (triangles ? " triangles, " : " cells, ")
               << dof_handler.n_dofs() << " DoFs, " << cg_iterations
               << " CG iterations\n\n"
               << "| step | s | peak MiB | peak B/DoF | current B/DoF |\n"
@@ -641,8 +788,9 @@ namespace setup_floor
   SetupFloor::objects_held() const
   {
     return {
-      {"triangulation (with p4est)",
-       static_cast<double>(triangulation.memory_consumption())},
+      {triangles ? "triangulation (the whole mesh)" :
+                   "triangulation (with p4est)",
+       static_cast<double>(triangulation->memory_consumption())},
       {"DoF handler", static_cast<double>(dof_handler.memory_consumption())},
       {"constraints", static_cast<double>(constraints.memory_consumption())},
       {"matrix", static_cast<double>(system_matrix.memory_consumption())},
@@ -675,14 +823,24 @@ main(int argc, char *argv[])
   try
     {
       dealii::Utilities::MPI::MPI_InitFinalize mpi_initialization(argc, argv);
-      const unsigned int refinements = (argc > 1) ? std::stoi(argv[1]) : 9;
-      const std::string  coupling    = (argc > 2) ? argv[2] : "components";
+      const std::string cell_type = (argc > 1) ? argv[1] : "quadrilateral";
+      if (cell_type != "quadrilateral" && cell_type != "triangle")
+        throw std::invalid_argument("the cell type is 'quadrilateral' or "
+                                    "'triangle', not '" +
+                                    cell_type + "'");
+      const bool triangles = (cell_type == "triangle");
+      // The previous mesh of the last cycle of case M (512 × 512 cells) or
+      // of degenerate-free-boundary.prm (131 072 triangles).
+      const unsigned int refinements =
+        (argc > 2) ? std::stoi(argv[2]) : (triangles ? 7 : 9);
+      const std::string coupling = (argc > 3) ? argv[3] : "components";
       if (coupling != "components" && coupling != "full")
         throw std::invalid_argument("the coupling is 'components' or 'full', "
                                     "not '" +
                                     coupling + "'");
-      const bool trim = (argc > 3) && std::string(argv[3]) == "trim";
-      setup_floor::SetupFloor(refinements, coupling == "full", trim).run();
+      const bool trim = (argc > 4) && std::string(argv[4]) == "trim";
+      setup_floor::SetupFloor(triangles, refinements, coupling == "full", trim)
+        .run();
     }
   catch (const std::exception &exception)
     {

@@ -7,8 +7,11 @@
 # Defaults: build/setup_floor of this repository (made by
 # `cmake --build build --target setup_floor`) and /tmp/membranes-setup-floor.
 # RUNS=n in the environment sets the number of runs (default 3),
-# REFINEMENTS=k the refinements of the previous mesh (default 9: the
-# measured cycle goes from 512 × 512 to 1024 × 1024 cells), COUPLING=full
+# CELL=triangle the mesh of triangles of membranes' `Cell type = triangle`
+# instead of quadrilaterals (CELL=quadrilateral, the default),
+# REFINEMENTS=k the refinements of the previous mesh (default 9 on
+# quadrilaterals: the measured cycle goes from 512 × 512 to 1024 × 1024
+# cells; 7 on triangles: from 131 072 to 524 288 triangles), COUPLING=full
 # the sparsity pattern of the coupled system instead of the mesh's
 # operator (COUPLING=components, the default), TRIM=1 the memory freed in
 # each step given back to the system before the resident set is read (the
@@ -21,6 +24,12 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 program=${1:-$root/build/setup_floor}
 out=${2:-/tmp/membranes-setup-floor}
 runs=${RUNS:-3}
+cell=${CELL:-quadrilateral}
+if [[ $cell == triangle ]]; then
+  refinements=${REFINEMENTS:-7}
+else
+  refinements=${REFINEMENTS:-9}
+fi
 
 if [[ ! -x $program ]]; then
   echo "setup_floor.sh: error: '$program' is not an executable" >&2
@@ -32,7 +41,7 @@ rm -f "$out"/run*.md
 echo "== $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at start"
 for ((run = 1; run <= runs; ++run)); do
   echo "== run $run"
-  nice "$program" "${REFINEMENTS:-9}" "${COUPLING:-components}" \
+  nice "$program" "$cell" "$refinements" "${COUPLING:-components}" \
     ${TRIM:+trim} | tee "$out/run$run.md"
 done
 echo "== load average $(cut -d' ' -f1-3 /proc/loadavg) at end"
