@@ -384,10 +384,10 @@ namespace membranes
     std::vector<StatusChange>        predicted;
     if (history.cycles() == 0)
       {
-        predicted                     = predicted_changes(solution, changes);
-        update.predicted_force_scales = {
-          {predicted_action.force_scale(),
-           predicted_action.contact_force_scale()}};
+        predicted = predicted_changes(solution, changes);
+        update.predicted_force_scales =
+          std::array<double, 2>{{predicted_action.force_scale(),
+                                 predicted_action.contact_force_scale()}};
         if (Utilities::MPI::sum(predicted.size(),
                                 problem->get_mpi_communicator()) > 0)
           next = &predicted;
