@@ -2,6 +2,7 @@
 #define membranes_cell_loop_h
 
 #include <atomic>
+#include <deal.II/base/multithread_info.h>
 #include <deal.II/base/work_stream.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <exception>
@@ -48,6 +49,11 @@ namespace membranes
 
 
 
+  /** Items per chunk of run_in_order(). */
+  constexpr unsigned int chunk_size = 64;
+
+
+
   /**
    * Run @p worker(item, scratch, copy) on every item of [@p begin, @p end),
    * on the threads of MultithreadInfo (deal.II's WorkStream, as in
@@ -55,6 +61,13 @@ namespace membranes
    * @p make_scratch, and @p copier(copy) on the results one at a time, in
    * the order of the items. Sums formed in the copier are therefore the
    * same, to the last bit, for any number of threads.
+   *
+   * WorkStream hands the items to the threads in chunks; each chunk costs
+   * a synchronization of the pipeline between the threads and the copier.
+   * The loops of this program do little work per cell (a few microseconds),
+   * so chunks of `chunk_size` items instead of WorkStream's default of 8
+   * keep that cost small against the work (benchmarks/README.md, "The
+   * chunks of the cell loops").
    *
    * An exception thrown by the worker (an expression of the scene that is
    * not finite at a point) would end the program in WorkStream, which
@@ -101,7 +114,9 @@ namespace membranes
           copier(copy);
       },
       ThreadScratch<Scratch>(make_scratch),
-      Copy());
+      Copy(),
+      2 * MultithreadInfo::n_threads(),
+      chunk_size);
     if (failure)
       std::rethrow_exception(failure);
   }
