@@ -146,7 +146,7 @@ namespace membranes
 
 
   double
-  displacement_scale(const TrilinosWrappers::MPI::Vector &solution)
+  displacement_scale(const TrilinosWrappers::MPI::BlockVector &solution)
   {
     return std::max(solution.linfty_norm(), std::numeric_limits<double>::min());
   }
@@ -181,7 +181,7 @@ namespace membranes
   template <int dim>
   void
   ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem,
-                         const VectorType           &solution,
+                         const BlockVectorType      &solution,
                          const VectorType           &ghosted_lambda_h)
   {
     reinit(discrete_problem);
@@ -192,12 +192,12 @@ namespace membranes
       {
         const auto  &a      = vertices[k];
         const double c      = contact_stiffness(a);
-        const double lambda = ghosted_lambda_h[a.dof[0]] / (c * u_scale);
+        const double lambda = ghosted_lambda_h[a.dof] / (c * u_scale);
         const double w      = nodal_w(k, solution) / u_scale;
         const bool   degenerate =
           std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
         if (!degenerate && lambda - w > 0)
-          active_vertices.add_index(a.dof[0]);
+          active_vertices.add_index(a.dof);
       }
     active_vertices.compress();
     set_flags();
@@ -209,13 +209,13 @@ namespace membranes
   void
   ActiveSet<dim>::set_flags()
   {
-    // Both are sorted by the u1 DoF.
+    // Both are sorted by the DoF.
     const auto &vertices = problem->vertices();
     auto        active   = active_vertices.begin();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         active_flags[k] =
-          (active != active_vertices.end() && *active == vertices[k].dof[0]);
+          (active != active_vertices.end() && *active == vertices[k].dof);
         if (active_flags[k])
           ++active;
       }
@@ -257,34 +257,11 @@ namespace membranes
     flags = owned_flags;
 
     IndexSet relevant_active_set(active_vertices.size());
-    for (const auto &dofs : problem->locally_relevant_vertices())
-      if (flags[dofs[0]] > 0)
-        relevant_active_set.add_index(dofs[0]);
+    for (const auto dof : problem->locally_relevant_vertices())
+      if (flags[dof] > 0)
+        relevant_active_set.add_index(dof);
     relevant_active_set.compress();
     return relevant_active_set;
-  }
-
-
-
-  template <int dim>
-  typename ActiveSet<dim>::VectorType
-  ActiveSet<dim>::lambda_and_flags(const VectorType &lambda_h) const
-  {
-    VectorType  fields(problem->locally_owned_dofs(),
-                      problem->get_mpi_communicator());
-    const auto &vertices = problem->vertices();
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const auto &a    = vertices[k];
-        fields[a.dof[0]] = lambda_h[a.dof[0]];
-        fields[a.dof[1]] = is_active(k) ? 1 : 0;
-      }
-    fields.compress(VectorOperation::insert);
-    VectorType ghosted_fields(problem->locally_owned_dofs(),
-                              problem->locally_relevant_dofs(),
-                              problem->get_mpi_communicator());
-    ghosted_fields = fields;
-    return ghosted_fields;
   }
 
 
@@ -301,7 +278,7 @@ namespace membranes
   template <int dim>
   KKTDefects
   ActiveSet<dim>::kkt_defects(const DiscreteAction<dim> &action,
-                              const VectorType          &solution) const
+                              const BlockVectorType     &solution) const
   {
     const double max = std::numeric_limits<double>::max();
     KKTDefects   defects{0, 0, max, max, max, 0};
@@ -344,7 +321,7 @@ namespace membranes
   template <int dim>
   std::vector<StatusChange>
   ActiveSet<dim>::wanted_changes(const DiscreteAction<dim> &action,
-                                 const VectorType          &solution) const
+                                 const BlockVectorType     &solution) const
   {
     const double epsilon = parameters.tolerance;
     const double u_scale = displacement_scale(solution);
@@ -358,7 +335,7 @@ namespace membranes
           is_active(k) ? -action.lambda(k) / (contact_stiffness(a) * u_scale) :
                          -nodal_w(k, solution) / u_scale;
         if (violation > epsilon)
-          changes.push_back({a.dof[0], violation / epsilon});
+          changes.push_back({a.dof, violation / epsilon});
       }
     return changes;
   }
@@ -376,7 +353,7 @@ namespace membranes
 
   template <int dim>
   typename ActiveSet<dim>::Update
-  ActiveSet<dim>::update(const VectorType                &solution,
+  ActiveSet<dim>::update(const BlockVectorType           &solution,
                          const std::vector<StatusChange> &changes)
   {
     Update                           update;
@@ -404,7 +381,7 @@ namespace membranes
   template <int dim>
   std::vector<StatusChange>
   ActiveSet<dim>::predicted_changes(
-    const VectorType                &solution,
+    const BlockVectorType           &solution,
     const std::vector<StatusChange> &plain_changes)
   {
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
@@ -422,22 +399,17 @@ namespace membranes
     // end U1 moves by μ2/M and U2 by −μ1/M of the change of W.
     const double *const lifted_1 = problem->lifted_loads(0).begin();
     const double *const lifted_2 = problem->lifted_loads(1).begin();
-    VectorType          w(problem->locally_owned_scalar_dofs(),
-                 problem->get_mpi_communicator());
+    BlockVectorType     iterate  = solution;
+    VectorType          w        = iterate.block(0);
+    w -= iterate.block(1);
     VectorType          stiffness_w(w);
     double *const       w_values = w.begin();
-    VectorType          iterate  = solution;
-    double *const       values   = iterate.begin();
-    for (unsigned int p = 0; p < w.locally_owned_size(); ++p)
-      w_values[p] = values[2 * p] - values[2 * p + 1];
     const VectorType    start_w(w);
     std::vector<double> load(vertices.size()),
       inverse_diagonal(vertices.size());
-    std::vector<unsigned int> scalar_position(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const unsigned int p = positions[k][0] / 2;
-        scalar_position[k]   = p;
+        const unsigned int p = positions[k];
         load[k]              = (mu2 * lifted_1[p] - mu1 * lifted_2[p]) / M;
         inverse_diagonal[k] =
           2 / (data.mu_bar * vertices[k].stiffness_row_l1_norm);
@@ -448,18 +420,15 @@ namespace membranes
         problem->laplace_matrix().vmult(stiffness_w, w);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
-            const unsigned int p = scalar_position[k];
+            const unsigned int p = positions[k];
             const double       r = data.mu_bar * product[p] - load[k];
             w_values[p] = std::max(0., w_values[p] - r * inverse_diagonal[k]);
           }
       }
-    const double *const start = start_w.begin();
-    for (unsigned int p = 0; p < w.locally_owned_size(); ++p)
-      {
-        const double step = w_values[p] - start[p];
-        values[2 * p] += mu2 / M * step;
-        values[2 * p + 1] -= mu1 / M * step;
-      }
+    VectorType &step = w;
+    step -= start_w;
+    iterate.block(0).add(mu2 / M, step);
+    iterate.block(1).add(-mu1 / M, step);
     predicted_action.compute(iterate);
 
     // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
@@ -474,19 +443,19 @@ namespace membranes
           (c * u_scale);
         const double violation = is_active(k) ? -test : test;
         if (violation > epsilon)
-          changes.push_back({a.dof[0], violation / epsilon});
+          changes.push_back({a.dof, violation / epsilon});
         else if (std::abs(test) <= epsilon)
           {
             // The prediction is indifferent here: the plain test decides.
             const auto plain =
               std::lower_bound(plain_changes.begin(),
                                plain_changes.end(),
-                               a.dof[0],
+                               a.dof,
                                [](const StatusChange           &change,
                                   const types::global_dof_index dof) {
                                  return change.dof < dof;
                                });
-            if (plain != plain_changes.end() && plain->dof == a.dof[0])
+            if (plain != plain_changes.end() && plain->dof == a.dof)
               changes.push_back(*plain);
           }
       }

@@ -84,14 +84,9 @@ namespace membranes
   ActiveSetSolver<dim>::setup(
     const DiscreteProblem<dim>      &discrete_problem,
     const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const DoFHandler<dim>           &scalar_dof_handler)
+    const AffineConstraints<double> &hanging_node_constraints)
   {
-    problem = &discrete_problem;
-    system->setup(discrete_problem,
-                  dof_handler,
-                  hanging_node_constraints,
-                  scalar_dof_handler);
+    system->setup(discrete_problem, dof_handler, hanging_node_constraints);
 
     // The constants of balanced stopping: C_F of the bounding box of the
     // mesh, c_M of the lumped mass, and d_min.
@@ -347,10 +342,12 @@ namespace membranes
 
   template <int dim>
   typename ActiveSetSolver<dim>::Statistics
-  ActiveSetSolver<dim>::solve(DiscreteAction<dim> &action,
-                              VectorType          &solution,
-                              ActiveSet<dim>      &active_set,
-                              const double         expected_error)
+  ActiveSetSolver<dim>::solve(const DiscreteProblem<dim> &problem,
+                              const DoFHandler<dim>      &dof_handler,
+                              DiscreteAction<dim>        &action,
+                              VectorType                 &solution,
+                              ActiveSet<dim>             &active_set,
+                              const double                expected_error)
   {
     Statistics    statistics;
     StoppingState stopping = start(expected_error);
@@ -360,14 +357,20 @@ namespace membranes
         const unsigned int linear_iterations = statistics.linear_iterations;
         {
           TimerOutput::Scope scope(timer, "assembly");
-          system->assemble(active_set.locally_relevant(), solution);
+          system->assemble(problem,
+                           dof_handler,
+                           active_set.locally_relevant(),
+                           solution);
         }
         TimerOutput::Scope scope(timer, "solve");
         // The forces of the initial guess set the tolerances of the first
         // linear solve.
         if (statistics.iterations == 1)
           compute_action(action, solution, stopping);
-        system->solve(solution, linear_tolerances(stopping), statistics);
+        system->solve(problem,
+                      solution,
+                      linear_tolerances(stopping),
+                      statistics);
         compute_action(action, solution, stopping);
         const auto changes = active_set.wanted_changes(action, solution);
         const auto n_changes =

@@ -13,7 +13,6 @@ namespace membranes
     , data(data)
     , mpi_communicator(mpi_communicator)
     , linear_solver(parameters.linear_solver, mpi_communicator)
-    , problem(nullptr)
     , method(method)
   {}
 

@@ -7,28 +7,17 @@ namespace membranes
   template <int dim>
   CellSystem<dim>::CellSystem(const Discretization<dim> &discretization,
                               const ProblemData<dim>    &data)
-    : laplace_matrix(discretization.fe->base_element(0).n_dofs_per_cell(),
-                     discretization.fe->base_element(0).n_dofs_per_cell())
-    , matrix(discretization.fe->n_dofs_per_cell(),
-             discretization.fe->n_dofs_per_cell())
-    , rhs(discretization.fe->n_dofs_per_cell())
+    : laplace_matrix(discretization.fe->n_dofs_per_cell(),
+                     discretization.fe->n_dofs_per_cell())
     , lumped_mass(discretization.fe->n_dofs_per_cell())
     , dof_indices(discretization.fe->n_dofs_per_cell())
     , data(data)
     , fe_values(*discretization.mapping,
-                discretization.fe->base_element(0),
+                *discretization.fe,
                 discretization.cell_quadrature,
                 update_values | update_gradients | update_quadrature_points |
                   update_JxW_values)
-    , scalar_lumped_mass(discretization.fe->base_element(0).n_dofs_per_cell())
   {
-    for (unsigned int j = 0; j < discretization.fe->n_dofs_per_cell(); ++j)
-      {
-        const auto component_and_index =
-          discretization.fe->system_to_component_index(j);
-        membrane.push_back(component_and_index.first);
-        scalar_index.push_back(component_and_index.second);
-      }
     for (unsigned int i = 0; i < 2; ++i)
       loads[i].reinit(laplace_matrix.m());
   }
@@ -61,8 +50,6 @@ namespace membranes
           load_oscillation[i] +=
             std::pow(f[q] - load_mean[i], 2) * fe_values.JxW(q);
       }
-    for (unsigned int j = 0; j < dof_indices.size(); ++j)
-      rhs(j) = loads[membrane[j]](scalar_index[j]);
   }
 
 
@@ -72,13 +59,11 @@ namespace membranes
   CellSystem<dim>::reinit_operator(
     const typename DoFHandler<dim>::active_cell_iterator &cell)
   {
-    // The FEValues object belongs to the scalar element, not to the
-    // DoFHandler's FESystem: it sees the cell only as a cell of the mesh.
-    fe_values.reinit(typename Triangulation<dim>::cell_iterator(cell));
+    fe_values.reinit(cell);
     cell->get_dof_indices(dof_indices);
 
-    laplace_matrix     = 0;
-    scalar_lumped_mass = 0;
+    laplace_matrix = 0;
+    lumped_mass    = 0;
     for (const unsigned int q : fe_values.quadrature_point_indices())
       for (const unsigned int v : fe_values.dof_indices())
         {
@@ -86,22 +71,8 @@ namespace membranes
             laplace_matrix(v, w) += fe_values.shape_grad(v, q) *
                                     fe_values.shape_grad(w, q) *
                                     fe_values.JxW(q);
-          scalar_lumped_mass(v) +=
-            fe_values.shape_value(v, q) * fe_values.JxW(q);
+          lumped_mass(v) += fe_values.shape_value(v, q) * fe_values.JxW(q);
         }
-
-    // The membranes do not couple in (3.4): the FESystem's matrix is block
-    // diagonal, one block μ_i A_K per membrane.
-    for (unsigned int j = 0; j < dof_indices.size(); ++j)
-      {
-        const unsigned int c = membrane[j];
-        for (unsigned int k = 0; k < dof_indices.size(); ++k)
-          matrix(j, k) =
-            (membrane[k] == c ?
-               data.mu[c] * laplace_matrix(scalar_index[j], scalar_index[k]) :
-               0.);
-        lumped_mass(j) = scalar_lumped_mass(scalar_index[j]);
-      }
   }
 
 
@@ -113,8 +84,6 @@ namespace membranes
     for (auto &load : loads)
       for (unsigned int v = 0; v < load.size(); ++v)
         load(v) = *cell_loads++;
-    for (unsigned int j = 0; j < dof_indices.size(); ++j)
-      rhs(j) = loads[membrane[j]](scalar_index[j]);
   }
 
 
@@ -136,15 +105,6 @@ namespace membranes
       cell_loads = std::copy(load.begin(), load.end(), cell_loads);
     cell_loads = std::copy(load_mean.begin(), load_mean.end(), cell_loads);
     std::copy(load_oscillation.begin(), load_oscillation.end(), cell_loads);
-  }
-
-
-
-  template <int dim>
-  unsigned int
-  CellSystem<dim>::scalar_index_of(const unsigned int j) const
-  {
-    return scalar_index[j];
   }
 
 

@@ -1,6 +1,9 @@
+#include <algorithm>
 #include <cmath>
 #include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/diagonal_matrix.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/linear_operator.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <membranes/cell_system.h>
 #include <membranes/coupled_system.h>
@@ -22,64 +25,166 @@ namespace membranes
 
 
   template <int dim>
-  void
-  CoupledSystem<dim>::setup(
-    const DiscreteProblem<dim>      &problem,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const DoFHandler<dim> &)
+  IndexSet
+  CoupledSystem<dim>::system_unknowns(const IndexSet &dofs) const
   {
-    this->problem                 = &problem;
-    this->dof_handler             = &dof_handler;
-    const IndexSet &owned_dofs    = problem.locally_owned_dofs();
-    const IndexSet &relevant_dofs = problem.locally_relevant_dofs();
-    make_mesh_constraints(*this->discretization.mapping,
-                          dof_handler,
-                          hanging_node_constraints,
-                          this->data.boundary_values(),
-                          mesh_constraints);
-    this->linear_solver.reinit(dof_handler);
-
-    // The contact constraint u1(a) = u2(a) only ever couples DoFs of
-    // vertices that share a cell, so the full coupling of all DoFs of a
-    // cell (condensed with the constraints of the mesh) holds the matrix
-    // of every active set, as step-41's pattern holds that of every active
-    // set of its obstacle problem.
-    DynamicSparsityPattern dsp(relevant_dofs);
-    DoFTools::make_sparsity_pattern(dof_handler, dsp, mesh_constraints, false);
-    SparsityTools::distribute_sparsity_pattern(dsp,
-                                               owned_dofs,
-                                               this->mpi_communicator,
-                                               relevant_dofs);
-    system_matrix.reinit(owned_dofs, owned_dofs, dsp, this->mpi_communicator);
-    system_rhs.reinit(owned_dofs, this->mpi_communicator);
-
-    // The tension μ_i of the membrane of each locally owned DoF: the DoFs
-    // of (u1, u2) alternate.
-    tension.reinit(owned_dofs, this->mpi_communicator);
-    for (unsigned int p = 0; p < tension.locally_owned_size(); ++p)
-      tension.begin()[p] = this->data.mu[p % 2];
+    IndexSet unknowns(block_indices.total_size());
+    for (unsigned int i = 0; i < 2; ++i)
+      unknowns.add_indices(dofs, block_indices.block_start(i));
+    unknowns.compress();
+    return unknowns;
   }
 
 
 
   template <int dim>
   void
-  CoupledSystem<dim>::assemble_system()
+  CoupledSystem<dim>::get_system_indices(
+    const std::vector<types::global_dof_index> &dofs,
+    std::vector<types::global_dof_index>       &indices) const
   {
-    CellSystem<dim> cell_system(this->discretization, this->data);
-    system_matrix = 0;
-    system_rhs    = 0;
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    indices.resize(2 * dofs.size());
+    for (unsigned int i = 0; i < 2; ++i)
+      for (unsigned int v = 0; v < dofs.size(); ++v)
+        indices[i * dofs.size() + v] =
+          block_indices.local_to_global(i, dofs[v]);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::setup(
+    const DiscreteProblem<dim>      &problem,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints)
+  {
+    block_indices.reinit(2, dof_handler.n_dofs());
+    const IndexSet owned    = system_unknowns(problem.locally_owned_dofs());
+    const IndexSet relevant = system_unknowns(problem.locally_relevant_dofs());
+
+    // The constraints of membrane i (hanging nodes, boundary values g_i)
+    // on the unknowns of block i.
+    mesh_constraints.clear();
+    mesh_constraints.reinit(relevant);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        AffineConstraints<double> membrane_constraints;
+        problem.make_constraints(dof_handler,
+                                 hanging_node_constraints,
+                                 i == 0 ? 1 : 0,
+                                 i == 0 ? 0 : 1,
+                                 membrane_constraints);
+        for (const auto &line : membrane_constraints.get_lines())
+          {
+            const auto row = block_indices.local_to_global(i, line.index);
+            mesh_constraints.add_line(row);
+            for (const auto &[column, weight] : line.entries)
+              mesh_constraints.add_entry(
+                row, block_indices.local_to_global(i, column), weight);
+            mesh_constraints.set_inhomogeneity(row, line.inhomogeneity);
+          }
+      }
+    mesh_constraints.close();
+
+    // The constants of each membrane are the near null space of the system.
+    const unsigned int n_owned = problem.locally_owned_dofs().n_elements();
+    std::vector<std::vector<bool>> constant_modes(2,
+                                                  std::vector<bool>(2 * n_owned,
+                                                                    false));
+    for (unsigned int i = 0; i < 2; ++i)
+      std::fill_n(constant_modes[i].begin() + i * n_owned, n_owned, true);
+    this->linear_solver.reinit(block_indices.total_size(), constant_modes);
+
+    // The contact constraint u1(a) = u2(a) only ever couples unknowns of
+    // vertices that share a cell, so the full coupling of all unknowns of a
+    // cell (condensed with the constraints of the mesh) holds the matrix
+    // of every active set, as step-41's pattern holds that of every active
+    // set of its obstacle problem.
+    DynamicSparsityPattern               dsp(relevant);
+    std::vector<types::global_dof_index> dofs(
+      dof_handler.get_fe().n_dofs_per_cell());
+    std::vector<types::global_dof_index> indices;
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
+          cell->get_dof_indices(dofs);
+          get_system_indices(dofs, indices);
+          mesh_constraints.add_entries_local_to_global(indices, dsp, false);
+        }
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               owned,
+                                               this->mpi_communicator,
+                                               relevant);
+    system_matrix.reinit(owned, owned, dsp, this->mpi_communicator);
+    system_rhs.reinit(owned, this->mpi_communicator);
+    system_solution.reinit(owned, this->mpi_communicator);
+    // The tension μ_i of the membrane of each locally owned unknown: those
+    // of u1, then those of u2.
+    tension.reinit(owned, this->mpi_communicator);
+    std::fill_n(tension.begin(), n_owned, this->data.mu[0]);
+    std::fill_n(tension.begin() + n_owned, n_owned, this->data.mu[1]);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::copy_to_system(const BlockVectorType &solution)
+  {
+    // The local storage of system_solution holds the owned entries of u1,
+    // then those of u2.
+    const unsigned int n_owned = solution.block(0).locally_owned_size();
+    for (unsigned int i = 0; i < 2; ++i)
+      std::copy_n(solution.block(i).begin(),
+                  n_owned,
+                  system_solution.begin() + i * n_owned);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::copy_from_system(BlockVectorType &solution) const
+  {
+    const unsigned int n_owned = solution.block(0).locally_owned_size();
+    for (unsigned int i = 0; i < 2; ++i)
+      std::copy_n(system_solution.begin() + i * n_owned,
+                  n_owned,
+                  solution.block(i).begin());
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::assemble_system(const DiscreteProblem<dim> &problem,
+                                      const DoFHandler<dim>      &dof_handler)
+  {
+    CellSystem<dim>    cell_system(this->discretization, this->data);
+    const unsigned int n_vertices = cell_system.dof_indices.size();
+    FullMatrix<double> cell_matrix(2 * n_vertices);
+    Vector<double>     cell_rhs(2 * n_vertices);
+    std::vector<types::global_dof_index> indices;
+    system_matrix = 0;
+    system_rhs    = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          // Block diagonal: μ_i A_K and F_iK on membrane i.
           cell_system.reinit_operator(cell);
-          cell_system.set_loads(this->problem->cell_loads(cell));
-          constraints.distribute_local_to_global(cell_system.matrix,
-                                                 cell_system.rhs,
-                                                 cell_system.dof_indices,
-                                                 system_matrix,
-                                                 system_rhs);
+          cell_system.set_loads(problem.cell_loads(cell));
+          for (unsigned int i = 0; i < 2; ++i)
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              {
+                for (unsigned int w = 0; w < n_vertices; ++w)
+                  cell_matrix(i * n_vertices + v, i * n_vertices + w) =
+                    this->data.mu[i] * cell_system.laplace_matrix(v, w);
+                cell_rhs(i * n_vertices + v) = cell_system.loads[i](v);
+              }
+          get_system_indices(cell_system.dof_indices, indices);
+          constraints.distribute_local_to_global(
+            cell_matrix, cell_rhs, indices, system_matrix, system_rhs);
         }
     system_matrix.compress(VectorOperation::add);
     system_rhs.compress(VectorOperation::add);
@@ -89,15 +194,16 @@ namespace membranes
 
   template <int dim>
   typename CoupledSystem<dim>::VectorType
-  CoupledSystem<dim>::tension_scaling(const IndexSet &active_set) const
+  CoupledSystem<dim>::tension_scaling(const DiscreteProblem<dim> &problem,
+                                      const IndexSet &active_set) const
   {
     const double M       = this->data.mu[0] + this->data.mu[1];
     VectorType   scaling = tension;
-    for (const auto &dofs : this->problem->locally_relevant_vertices())
-      if (active_set.is_element(dofs[0]))
-        for (const auto dof : dofs)
-          if (this->problem->locally_owned_dofs().is_element(dof))
-            scaling[dof] = M;
+    for (const auto dof : problem.locally_relevant_vertices())
+      if (active_set.is_element(dof) &&
+          problem.locally_owned_dofs().is_element(dof))
+        for (unsigned int i = 0; i < 2; ++i)
+          scaling[block_indices.local_to_global(i, dof)] = M;
     for (auto &entry : scaling)
       entry = 1 / std::sqrt(entry);
     scaling.compress(VectorOperation::insert);
@@ -108,33 +214,42 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::assemble(const IndexSet &active_set, VectorType &solution)
+  CoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
+                               const DoFHandler<dim>      &dof_handler,
+                               const IndexSet             &active_set,
+                               BlockVectorType            &solution)
   {
     constraints.clear();
-    constraints.reinit(this->problem->locally_relevant_dofs());
-    for (const auto &dofs : this->problem->locally_relevant_vertices())
-      if (active_set.is_element(dofs[0]))
+    constraints.reinit(mesh_constraints.get_local_lines());
+    for (const auto dof : problem.locally_relevant_vertices())
+      if (active_set.is_element(dof))
         {
-          constraints.add_line(dofs[0]);
-          constraints.add_entry(dofs[0], dofs[1], 1.0);
+          const auto u1 = block_indices.local_to_global(0, dof);
+          constraints.add_line(u1);
+          constraints.add_entry(u1, block_indices.local_to_global(1, dof), 1.0);
         }
     constraints.merge(mesh_constraints);
     constraints.close();
-    constraints.distribute(solution);
-    assemble_system();
-    scaling = tension_scaling(active_set);
+    copy_to_system(solution);
+    constraints.distribute(system_solution);
+    copy_from_system(solution);
+    assemble_system(problem, dof_handler);
+    scaling = tension_scaling(problem, active_set);
   }
 
 
 
   template <int dim>
   void
-  CoupledSystem<dim>::solve(VectorType             &solution,
+  CoupledSystem<dim>::solve(const DiscreteProblem<dim> &,
+                            BlockVectorType        &solution,
                             const LinearTolerances &tolerances,
                             ActiveSetStatistics    &statistics)
   {
+    VectorType &x = system_solution;
+    copy_to_system(solution);
     if (this->linear_solver.is_direct())
-      this->linear_solver.solve_direct(system_matrix, solution, system_rhs);
+      this->linear_solver.solve_direct(system_matrix, x, system_rhs);
     else
       {
         // CG on the system scaled by D = diag(m_j^{-1/2}), m_j = μ_i for
@@ -149,24 +264,28 @@ namespace membranes
           entry = 1 / entry;
         VectorType rhs = system_rhs;
         rhs.scale(scaling);
-        solution.scale(inverse_scaling);
+        x.scale(inverse_scaling);
         this->linear_solver.initialize_preconditioner(system_matrix);
         const double tolerance =
           std::min(tolerances.contact / std::sqrt(this->data.mu_bar),
                    tolerances.sum /
                      std::sqrt(this->data.mu[0] + this->data.mu[1]));
+        const DiagonalMatrix<VectorType> scale(scaling),
+          inverse_scale(inverse_scaling);
+        const auto K = linear_operator<VectorType>(system_matrix);
+        const auto D = linear_operator<VectorType>(system_matrix, scale);
+        const auto D_inverse =
+          linear_operator<VectorType>(system_matrix, inverse_scale);
+        const auto amg =
+          linear_operator<VectorType>(system_matrix,
+                                      this->linear_solver.preconditioner());
         statistics.linear_iterations += this->linear_solver.solve_cg(
-          ScaledOperator<TrilinosWrappers::SparseMatrix>(system_matrix,
-                                                         scaling),
-          ScaledOperator<TrilinosWrappers::PreconditionAMG>(
-            this->linear_solver.preconditioner(), inverse_scaling),
-          solution,
-          rhs,
-          tolerance);
+          D * K * D, D_inverse * amg * D_inverse, x, rhs, tolerance);
         this->linear_solver.clear();
-        solution.scale(scaling);
+        x.scale(scaling);
       }
-    constraints.distribute(solution);
+    constraints.distribute(x);
+    copy_from_system(solution);
   }
 
 
@@ -178,6 +297,7 @@ namespace membranes
     this->linear_solver.clear();
     system_matrix.clear();
     system_rhs.clear();
+    system_solution.clear();
     tension.clear();
     scaling.clear();
     constraints.clear();

@@ -1,3 +1,4 @@
+#include <deal.II/lac/linear_operator.h>
 #include <membranes/cell_loop.h>
 #include <membranes/cell_system.h>
 #include <membranes/decoupled_system.h>
@@ -23,17 +24,20 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::setup(const DiscreteProblem<dim> &problem,
-                              const DoFHandler<dim>      &dof_handler,
-                              const AffineConstraints<double> &,
-                              const DoFHandler<dim> &scalar_dof_handler)
+  DecoupledSystem<dim>::setup(
+    const DiscreteProblem<dim>      &problem,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints)
   {
-    this->problem     = &problem;
-    this->dof_handler = &dof_handler;
     const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    problem.make_constraints(scalar_dof_handler, mu1, mu2, s_constraints);
-    problem.make_constraints(scalar_dof_handler, 1, -1, w_constraints);
-    this->linear_solver.reinit(scalar_dof_handler);
+    problem.make_constraints(
+      dof_handler, hanging_node_constraints, mu1, mu2, s_constraints);
+    problem.make_constraints(
+      dof_handler, hanging_node_constraints, 1, -1, w_constraints);
+    // The constants are the near null space of the Laplacian.
+    this->linear_solver.reinit(
+      dof_handler.n_dofs(),
+      {std::vector<bool>(problem.locally_owned_dofs().n_elements(), true)});
 
     // The right-hand sides of S and W: the loads lifted by the boundary
     // values of each membrane combine into those lifted by the boundary
@@ -54,17 +58,19 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::make_obstacle_matrix(const IndexSet &active_set)
+  DecoupledSystem<dim>::make_obstacle_matrix(
+    const DiscreteProblem<dim> &problem,
+    const DoFHandler<dim>      &dof_handler,
+    const IndexSet             &active_set)
   {
     // The constraints W_a = 0 of the active vertices (locally relevant)
     // merged with those of the mesh, condensed by distribute_local_to_global
     // as step-41 condenses its active set: the rows and columns of the
     // active vertices eliminated.
     const double              coefficient = this->data.mu_bar;
-    AffineConstraints<double> constraints(
-      this->problem->locally_relevant_scalar_dofs());
+    AffineConstraints<double> constraints(problem.locally_relevant_dofs());
     for (const auto dof : active_set)
-      constraints.add_line(dof / 2);
+      constraints.add_line(dof);
     constraints.merge(w_constraints,
                       AffineConstraints<double>::right_object_wins);
     constraints.close();
@@ -74,11 +80,9 @@ namespace membranes
       FullMatrix<double>                   matrix;
       std::vector<types::global_dof_index> dof_indices;
     };
-    const FiniteElement<dim> &fe         = dof_handler->get_fe();
-    const unsigned int        n_vertices = fe.base_element(0).n_dofs_per_cell();
-    obstacle_matrix.reinit(this->problem->laplace_matrix());
+    obstacle_matrix.reinit(problem.laplace_matrix());
     run_on_cells<CellMatrix>(
-      *dof_handler,
+      dof_handler,
       [&]() {
         return std::make_unique<CellSystem<dim>>(this->discretization,
                                                  this->data);
@@ -90,10 +94,7 @@ namespace membranes
         cell_system.reinit_operator(cell);
         copy.matrix = cell_system.laplace_matrix;
         copy.matrix *= coefficient;
-        copy.dof_indices.resize(n_vertices);
-        for (unsigned int v = 0; v < n_vertices; ++v)
-          copy.dof_indices[v] =
-            cell_system.dof_indices[fe.component_to_system_index(0, v)] / 2;
+        copy.dof_indices = cell_system.dof_indices;
       },
       [&](const CellMatrix &copy) {
         if (!copy.dof_indices.empty())
@@ -108,53 +109,58 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::assemble(const IndexSet &active_set,
-                                 VectorType     &solution)
+  DecoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
+                                 const DoFHandler<dim>      &dof_handler,
+                                 const IndexSet             &active_set,
+                                 BlockVectorType            &solution)
   {
     // On the first iteration of a mesh: S and W of the initial guess.
     if (!s_solved)
       {
-        const double  mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-        const double *u        = solution.begin();
-        double *const s_values = s.begin(), *const w_values = w.begin();
-        for (unsigned int p = 0; p < s.locally_owned_size(); ++p)
-          {
-            s_values[p] = mu1 * u[2 * p] + mu2 * u[2 * p + 1];
-            w_values[p] = u[2 * p] - u[2 * p + 1];
-          }
+        s.equ(this->data.mu[0], solution.block(0));
+        s.add(this->data.mu[1], solution.block(1));
+        w.equ(1., solution.block(0));
+        w.add(-1., solution.block(1));
         s_constraints.distribute(s);
       }
 
-    // The positions of the locally owned active vertices in the scalar
-    // vectors (scalar DoF k = u1 DoF / 2); W = 0 there, and the right-hand
+    // Π, 1 at the inactive vertices and 0 at the active ones, and I − Π, as
+    // diagonal matrices; W = 0 at the active vertices, and the right-hand
     // side too. The matrix of W is condensed anew when the direct solver
     // factorizes it or when the AMG hierarchy is built from it.
-    const IndexSet &owned = s.locally_owned_elements();
-    active_positions.clear();
+    VectorType &inactive = inactive_projection.get_vector();
+    VectorType &active   = active_projection.get_vector();
+    inactive.reinit(w, true);
+    active.reinit(w, true);
+    inactive = 1;
+    active   = 0;
     for (const auto dof : active_set)
-      if (owned.is_element(dof / 2))
-        active_positions.push_back(owned.index_within_set(dof / 2));
+      if (inactive.in_local_range(dof))
+        {
+          inactive[dof] = 0;
+          active[dof]   = 1;
+        }
+    inactive.compress(VectorOperation::insert);
+    active.compress(VectorOperation::insert);
     rhs = w_rhs;
-    for (const unsigned int p : active_positions)
-      {
-        rhs.begin()[p] = 0;
-        w.begin()[p]   = 0;
-      }
+    rhs.scale(inactive);
+    w.scale(inactive);
     w_constraints.distribute(w);
     if (this->linear_solver.is_direct() ||
         !this->linear_solver.has_preconditioner())
-      make_obstacle_matrix(active_set);
+      make_obstacle_matrix(problem, dof_handler, active_set);
   }
 
 
 
   template <int dim>
   void
-  DecoupledSystem<dim>::solve_s(const double         tolerance,
-                                ActiveSetStatistics &statistics)
+  DecoupledSystem<dim>::solve_s(const DiscreteProblem<dim> &problem,
+                                const double                tolerance,
+                                ActiveSetStatistics        &statistics)
   {
     const TrilinosWrappers::SparseMatrix &laplace_matrix =
-      this->problem->laplace_matrix();
+      problem.laplace_matrix();
     if (this->linear_solver.is_direct())
       this->linear_solver.solve_direct(laplace_matrix, s, s_rhs);
     else
@@ -176,12 +182,13 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::solve(VectorType             &solution,
-                              const LinearTolerances &tolerances,
-                              ActiveSetStatistics    &statistics)
+  DecoupledSystem<dim>::solve(const DiscreteProblem<dim> &problem,
+                              BlockVectorType            &solution,
+                              const LinearTolerances     &tolerances,
+                              ActiveSetStatistics        &statistics)
   {
     if (!s_solved)
-      solve_s(tolerances.sum, statistics);
+      solve_s(problem, tolerances.sum, statistics);
 
     if (this->linear_solver.is_direct())
       this->linear_solver.solve_direct(obstacle_matrix, w, rhs);
@@ -192,18 +199,17 @@ namespace membranes
         const bool builds_hierarchy = !this->linear_solver.has_preconditioner();
         if (builds_hierarchy)
           this->linear_solver.initialize_preconditioner(obstacle_matrix);
-        const RestrictedOperator<TrilinosWrappers::SparseMatrix> op(
-          this->problem->laplace_matrix(),
-          this->data.mu_bar,
-          active_positions,
-          rhs);
-        const RestrictedOperator<TrilinosWrappers::PreconditionAMG>
-                           preconditioner(this->linear_solver.preconditioner(),
-                         1.,
-                         active_positions,
-                         rhs);
+        const auto &A  = problem.laplace_matrix();
+        const auto  Pi = linear_operator<VectorType>(A, inactive_projection);
+        const auto  I_minus_Pi =
+          linear_operator<VectorType>(A, active_projection);
+        const auto op =
+          Pi * (this->data.mu_bar * linear_operator<VectorType>(A)) * Pi +
+          I_minus_Pi;
+        const auto amg =
+          linear_operator<VectorType>(A, this->linear_solver.preconditioner());
         const unsigned int iterations = this->linear_solver.solve_cg(
-          op, preconditioner, w, rhs, tolerances.contact);
+          op, Pi * amg * Pi + I_minus_Pi, w, rhs, tolerances.contact);
         statistics.linear_iterations += iterations;
         if (builds_hierarchy)
           hierarchy_iterations = iterations;
@@ -212,14 +218,17 @@ namespace membranes
       }
     w_constraints.distribute(w);
 
+    // U1 = (S + μ2 W)/M and U2 = (S − μ1 W)/M, entry by entry: S, W and
+    // both blocks of the solution have the layout of the mesh's vectors.
     const double        mu1 = this->data.mu[0], mu2 = this->data.mu[1];
     const double        M        = mu1 + mu2;
     const double *const s_values = s.begin(), *const w_values = w.begin();
-    double *const u = solution.begin();
+    double *const u1 = solution.block(0).begin();
+    double *const u2 = solution.block(1).begin();
     for (unsigned int p = 0; p < s.locally_owned_size(); ++p)
       {
-        u[2 * p]     = (s_values[p] + mu2 * w_values[p]) / M;
-        u[2 * p + 1] = (s_values[p] - mu1 * w_values[p]) / M;
+        u1[p] = (s_values[p] + mu2 * w_values[p]) / M;
+        u2[p] = (s_values[p] - mu1 * w_values[p]) / M;
       }
   }
 
@@ -231,8 +240,13 @@ namespace membranes
   {
     this->linear_solver.clear();
     obstacle_matrix.clear();
-    active_positions = {};
-    for (VectorType *vector : {&s_rhs, &w_rhs, &s, &w, &rhs})
+    for (VectorType *vector : {&s_rhs,
+                               &w_rhs,
+                               &s,
+                               &w,
+                               &rhs,
+                               &inactive_projection.get_vector(),
+                               &active_projection.get_vector()})
       vector->clear();
     s_constraints.clear();
     w_constraints.clear();

@@ -23,36 +23,25 @@ namespace membranes
   DiscreteAction<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
   {
     problem = &discrete_problem;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        membrane_values[i].reinit(discrete_problem.locally_owned_scalar_dofs(),
-                                  discrete_problem.get_mpi_communicator());
-        stiffness_products[i].reinit(membrane_values[i]);
-      }
+    for (auto &product : stiffness_products)
+      product.reinit(discrete_problem.locally_owned_dofs(),
+                     discrete_problem.get_mpi_communicator());
   }
 
 
 
   template <int dim>
   void
-  DiscreteAction<dim>::compute(const VectorType &solution)
+  DiscreteAction<dim>::compute(const BlockVectorType &solution)
   {
     // The two terms of (4.5) at every vertex: μ_i ∫ ∇u_ih·∇φ as μ_i times
-    // the product of A with the nodal values U_i of membrane i (those of
-    // hanging nodes follow from their parents, whose columns hold the
-    // condensed couplings; those on ∂ω enter through the lifted loads, see
-    // stiffness_term()), and the loads ∫ f_i φ of this mesh. The FESystem
-    // stores U1 and U2 of a vertex one after the other.
-    const double *const values = solution.begin();
+    // the product of A with the nodal values U_i of membrane i, block i of
+    // the solution (those of hanging nodes follow from their parents, whose
+    // columns hold the condensed couplings; those on ∂ω enter through the
+    // lifted loads, see stiffness_term()), and the loads ∫ f_i φ of this
+    // mesh.
     for (unsigned int i = 0; i < 2; ++i)
-      {
-        double *const u = membrane_values[i].begin();
-        for (unsigned int p = 0; p < membrane_values[i].locally_owned_size();
-             ++p)
-          u[p] = values[2 * p + i];
-        problem->laplace_matrix().vmult(stiffness_products[i],
-                                        membrane_values[i]);
-      }
+      problem->laplace_matrix().vmult(stiffness_products[i], solution.block(i));
 
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
@@ -69,9 +58,10 @@ namespace membranes
     const auto  &positions = problem->local_positions();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
-    std::array<const double *, 2> products, load_values, lifted_values;
+    std::array<const double *, 2> values, products, load_values, lifted_values;
     for (unsigned int i = 0; i < 2; ++i)
       {
+        values[i]        = solution.block(i).begin();
         products[i]      = stiffness_products[i].begin();
         load_values[i]   = problem->loads(i).begin();
         lifted_values[i] = problem->lifted_loads(i).begin();
@@ -79,9 +69,8 @@ namespace membranes
     membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const Vertex         &a        = vertices[k];
-        const auto           &position = positions[k];
-        const unsigned int    p        = position[0] / 2;
+        const Vertex         &a = vertices[k];
+        const unsigned int    p = positions[k];
         std::array<double, 2> stiffness, loads;
         for (unsigned int i = 0; i < 2; ++i)
           {
@@ -94,18 +83,17 @@ namespace membranes
                                    (stiffness[i] - loads[i]) /
                                    a.dual_cell_measure;
         for (unsigned int i = 0; i < 2; ++i)
-          local_max = std::max({local_max,
-                                std::abs(stiffness[i]),
-                                std::abs(loads[i]),
-                                data.mu[i] * a.stiffness_diagonal *
-                                  std::abs(values[position[i]])});
-        local_contact_max =
-          std::max({local_contact_max,
-                    std::abs(mu2 * stiffness[0] - mu1 * stiffness[1]) / M,
-                    std::abs(mu2 * loads[0] - mu1 * loads[1]) / M,
-                    data.mu_bar * a.stiffness_diagonal *
-                      std::max(std::abs(values[position[0]]),
-                               std::abs(values[position[1]]))});
+          local_max = std::max(
+            {local_max,
+             std::abs(stiffness[i]),
+             std::abs(loads[i]),
+             data.mu[i] * a.stiffness_diagonal * std::abs(values[i][p])});
+        local_contact_max = std::max(
+          {local_contact_max,
+           std::abs(mu2 * stiffness[0] - mu1 * stiffness[1]) / M,
+           std::abs(mu2 * loads[0] - mu1 * loads[1]) / M,
+           data.mu_bar * a.stiffness_diagonal *
+             std::max(std::abs(values[0][p]), std::abs(values[1][p]))});
       }
     const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
@@ -143,8 +131,7 @@ namespace membranes
     VectorType nodal_values(problem->locally_owned_dofs(),
                             problem->get_mpi_communicator());
     for (unsigned int k = 0; k < vertices().size(); ++k)
-      for (const auto dof : vertices()[k].dof)
-        nodal_values[dof] = lambda(k);
+      nodal_values[vertices()[k].dof] = lambda(k);
     nodal_values.compress(VectorOperation::insert);
     hanging_node_constraints.distribute(nodal_values);
     VectorType ghosted(problem->locally_owned_dofs(),
@@ -173,7 +160,7 @@ namespace membranes
   {
     // μ_i (A U_i)_a with the columns of the free DoFs, plus those of ∂ω:
     // the loads minus the lifted loads, μ_i Σ_{b ∈ ∂ω} A_ab g_i(b).
-    const unsigned int p = problem->local_positions()[k][0] / 2;
+    const unsigned int p = problem->local_positions()[k];
     return data.mu[i] * stiffness_products[i].begin()[p] +
            (problem->loads(i).begin()[p] - problem->lifted_loads(i).begin()[p]);
   }
@@ -185,7 +172,7 @@ namespace membranes
   DiscreteAction<dim>::load_term(const unsigned int i,
                                  const unsigned int k) const
   {
-    return problem->loads(i).begin()[problem->local_positions()[k][0] / 2];
+    return problem->loads(i).begin()[problem->local_positions()[k]];
   }
 
 
@@ -290,8 +277,7 @@ namespace membranes
                                            std::vector<double> &values) const
   {
     values.resize(fe_values.n_quadrature_points);
-    fe_values[FEValuesExtractors::Scalar(0)].get_function_values(lambda_h,
-                                                                 values);
+    fe_values.get_function_values(lambda_h, values);
   }
 
 

@@ -55,74 +55,43 @@ namespace membranes
   DiscreteProblem<dim>::reinit(
     const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints,
-    const DoFHandler<dim>           &scalar_dof_handler,
     const MPI_Comm                   mpi_communicator)
   {
     this->mpi_communicator = mpi_communicator;
     owned_dofs             = dof_handler.locally_owned_dofs();
-    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant_dofs);
-    owned_scalar_dofs = scalar_dof_handler.locally_owned_dofs();
-    DoFTools::extract_locally_relevant_dofs(scalar_dof_handler,
-                                            relevant_scalar_dofs);
+    relevant_dofs          = hanging_node_constraints.get_local_lines();
 
-    // Both DoFHandlers number the vertices in the same order, the FESystem
-    // the DoFs of u1 and u2 at a vertex one after the other: the DoFs of
-    // scalar DoF k are 2k and 2k + 1, and the locally owned ones of both are
-    // one contiguous range. Checked here on the cells of this process.
-    AssertThrow(owned_dofs.is_contiguous() &&
-                  owned_scalar_dofs.is_contiguous() &&
-                  owned_dofs.n_elements() == 2 * owned_scalar_dofs.n_elements(),
-                ExcInternalError());
-    const FiniteElement<dim>            &fe = dof_handler.get_fe();
-    std::vector<types::global_dof_index> dof_indices(fe.n_dofs_per_cell());
-    std::vector<types::global_dof_index> scalar_dof_indices(
-      fe.base_element(0).n_dofs_per_cell());
-    for (const auto &scalar_cell : scalar_dof_handler.active_cell_iterators())
-      if (scalar_cell->is_locally_owned())
-        {
-          scalar_cell->get_dof_indices(scalar_dof_indices);
-          typename DoFHandler<dim>::active_cell_iterator(
-            &dof_handler.get_triangulation(),
-            scalar_cell->level(),
-            scalar_cell->index(),
-            &dof_handler)
-            ->get_dof_indices(dof_indices);
-          for (unsigned int v = 0; v < scalar_dof_indices.size(); ++v)
-            for (unsigned int i = 0; i < 2; ++i)
-              AssertThrow(dof_indices[fe.component_to_system_index(i, v)] ==
-                            2 * scalar_dof_indices[v] + i,
-                          ExcInternalError());
-        }
-
-    scalar_hanging_node_constraints.clear();
-    scalar_hanging_node_constraints.reinit(relevant_scalar_dofs);
-    DoFTools::make_hanging_node_constraints(scalar_dof_handler,
-                                            scalar_hanging_node_constraints);
-    scalar_hanging_node_constraints.close();
-    make_constraints(scalar_dof_handler, 1, 0, membrane_constraints[0]);
-    make_constraints(scalar_dof_handler, 0, 1, membrane_constraints[1]);
-
-    // The constraints of the two membranes are the same lines: one pattern,
-    // without the rows and columns of constrained DoFs.
-    DynamicSparsityPattern dsp(relevant_scalar_dofs);
-    DoFTools::make_sparsity_pattern(scalar_dof_handler,
+    // Hanging nodes and the boundary values g_1 = g, g_2 = g2 of each
+    // membrane. They constrain the same lines: one pattern, without the
+    // rows and columns of constrained DoFs.
+    std::array<AffineConstraints<double>, 2> membrane_constraints;
+    make_constraints(
+      dof_handler, hanging_node_constraints, 1, 0, membrane_constraints[0]);
+    make_constraints(
+      dof_handler, hanging_node_constraints, 0, 1, membrane_constraints[1]);
+    DynamicSparsityPattern dsp(relevant_dofs);
+    DoFTools::make_sparsity_pattern(dof_handler,
                                     dsp,
                                     membrane_constraints[0],
                                     false);
     SparsityTools::distribute_sparsity_pattern(dsp,
-                                               owned_scalar_dofs,
+                                               owned_dofs,
                                                mpi_communicator,
-                                               relevant_scalar_dofs);
-    matrix.reinit(owned_scalar_dofs, owned_scalar_dofs, dsp, mpi_communicator);
+                                               relevant_dofs);
+    matrix.reinit(owned_dofs, owned_dofs, dsp, mpi_communicator);
     for (unsigned int i = 0; i < 2; ++i)
       {
-        load_vectors[i].reinit(owned_scalar_dofs, mpi_communicator);
-        lifted_load_vectors[i].reinit(owned_scalar_dofs, mpi_communicator);
+        load_vectors[i].reinit(owned_dofs, mpi_communicator);
+        lifted_load_vectors[i].reinit(owned_dofs, mpi_communicator);
       }
 
-    VectorType dual_cell_measure(owned_scalar_dofs, mpi_communicator);
-    VectorType stiffness_diagonal(owned_scalar_dofs, mpi_communicator);
-    assemble(dof_handler, dual_cell_measure, stiffness_diagonal);
+    VectorType dual_cell_measure(owned_dofs, mpi_communicator);
+    VectorType stiffness_diagonal(owned_dofs, mpi_communicator);
+    assemble(dof_handler,
+             hanging_node_constraints,
+             membrane_constraints,
+             dual_cell_measure,
+             stiffness_diagonal);
     find_vertices(dof_handler,
                   hanging_node_constraints,
                   dual_cell_measure,
@@ -134,10 +103,11 @@ namespace membranes
   template <int dim>
   void
   DiscreteProblem<dim>::make_constraints(
-    const DoFHandler<dim>     &scalar_dof_handler,
-    const double               c1,
-    const double               c2,
-    AffineConstraints<double> &constraints) const
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const double                     c1,
+    const double                     c2,
+    AffineConstraints<double>       &constraints) const
   {
     const ScalarFunctionFromFunctionObject<dim> boundary_values(
       [this, c1, c2](const Point<dim> &p) {
@@ -145,8 +115,8 @@ namespace membranes
                c2 * data.boundary_values().value(p, 1);
       });
     make_mesh_constraints(*discretization.mapping,
-                          scalar_dof_handler,
-                          scalar_hanging_node_constraints,
+                          dof_handler,
+                          hanging_node_constraints,
                           boundary_values,
                           constraints);
   }
@@ -155,9 +125,12 @@ namespace membranes
 
   template <int dim>
   void
-  DiscreteProblem<dim>::assemble(const DoFHandler<dim> &dof_handler,
-                                 VectorType            &dual_cell_measure,
-                                 VectorType            &stiffness_diagonal)
+  DiscreteProblem<dim>::assemble(
+    const DoFHandler<dim>                          &dof_handler,
+    const AffineConstraints<double>                &hanging_node_constraints,
+    const std::array<AffineConstraints<double>, 2> &membrane_constraints,
+    VectorType                                     &dual_cell_measure,
+    VectorType                                     &stiffness_diagonal)
   {
     // The cell loop on threads: each works with its own CellSystem, the
     // loads of every cell go to that cell's own slot of loads_of_cells, and
@@ -174,8 +147,7 @@ namespace membranes
       Vector<double>                       lumped_mass, diagonal;
       std::vector<types::global_dof_index> dof_indices;
     };
-    const FiniteElement<dim> &fe         = dof_handler.get_fe();
-    const unsigned int        n_vertices = fe.base_element(0).n_dofs_per_cell();
+    const unsigned int n_vertices = dof_handler.get_fe().n_dofs_per_cell();
     loads_per_cell = CellSystem<dim>(discretization, data).n_load_entries();
     loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
                             loads_per_cell,
@@ -195,16 +167,11 @@ namespace membranes
           &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
         contribution.laplace_matrix = cell_system.laplace_matrix;
         contribution.loads          = cell_system.loads;
-        contribution.lumped_mass.reinit(n_vertices);
+        contribution.lumped_mass    = cell_system.lumped_mass;
+        contribution.dof_indices    = cell_system.dof_indices;
         contribution.diagonal.reinit(n_vertices);
-        contribution.dof_indices.resize(n_vertices);
         for (unsigned int v = 0; v < n_vertices; ++v)
-          {
-            const unsigned int j        = fe.component_to_system_index(0, v);
-            contribution.dof_indices[v] = cell_system.dof_indices[j] / 2;
-            contribution.lumped_mass(v) = cell_system.lumped_mass(j);
-            contribution.diagonal(v)    = cell_system.laplace_matrix(v, v);
-          }
+          contribution.diagonal(v) = cell_system.laplace_matrix(v, v);
       },
       [&](const CellContribution &contribution) {
         if (contribution.dof_indices.empty())
@@ -214,7 +181,7 @@ namespace membranes
           contribution.laplace_matrix, dofs, matrix);
         for (unsigned int i = 0; i < 2; ++i)
           {
-            scalar_hanging_node_constraints.distribute_local_to_global(
+            hanging_node_constraints.distribute_local_to_global(
               contribution.loads[i], dofs, load_vectors[i]);
             membrane_matrix.equ(data.mu[i], contribution.laplace_matrix);
             membrane_constraints[i].distribute_local_to_global(
@@ -223,7 +190,7 @@ namespace membranes
               lifted_load_vectors[i],
               membrane_matrix);
           }
-        scalar_hanging_node_constraints.distribute_local_to_global(
+        hanging_node_constraints.distribute_local_to_global(
           contribution.lumped_mass, dofs, dual_cell_measure);
         stiffness_diagonal.add(dofs, contribution.diagonal);
       });
@@ -248,12 +215,12 @@ namespace membranes
     const VectorType                &stiffness_diagonal)
   {
     // The interior vertices of the owned and ghost cells, each once (by
-    // its index in the mesh), by their DoFs (u1, u2).
+    // its index in the mesh), by their DoFs.
     const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
     const auto    &triangulation = dof_handler.get_triangulation();
     std::vector<char> seen(triangulation.n_vertices(), false);
     interior_vertex_flags.assign(triangulation.n_vertices(), false);
-    std::vector<std::array<types::global_dof_index, 2>> candidates;
+    std::vector<types::global_dof_index> candidates;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         for (const unsigned int v : cell->vertex_indices())
@@ -263,8 +230,7 @@ namespace membranes
               if (boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
                 continue;
               interior_vertex_flags[cell->vertex_index(v)] = true;
-              candidates.push_back(
-                {{cell->vertex_dof_index(v, 0), cell->vertex_dof_index(v, 1)}});
+              candidates.push_back(cell->vertex_dof_index(v, 0));
             }
     std::sort(candidates.begin(), candidates.end());
 
@@ -272,7 +238,7 @@ namespace membranes
     // of absolute values (deal.II's row iterator of a Trilinos matrix
     // resizes its row buffer to n() entries on every row it visits, which
     // makes a pass over all rows quadratic in the number of DoFs).
-    VectorType row_l1_norm(owned_scalar_dofs, mpi_communicator);
+    VectorType row_l1_norm(owned_dofs, mpi_communicator);
     AssertThrow(matrix.trilinos_matrix().InvRowSums(
                   *row_l1_norm.trilinos_vector()(0)) == 0,
                 ExcInternalError());
@@ -281,25 +247,22 @@ namespace membranes
     interior_vertices.clear();
     relevant_vertices.clear();
     interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
-    for (const auto &dofs : candidates)
+    for (const auto dof : candidates)
       {
-        interior_vertex_dofs.add_index(dofs[0]);
-        if (hanging_node_constraints.is_constrained(dofs[0]))
+        interior_vertex_dofs.add_index(dof);
+        if (hanging_node_constraints.is_constrained(dof))
           continue;
-        relevant_vertices.push_back(dofs);
-        const auto k = dofs[0] / 2;
-        if (owned_dofs.is_element(dofs[0]))
-          interior_vertices.push_back({dofs,
-                                       dual_cell_measure[k],
-                                       stiffness_diagonal[k],
-                                       1 / row_l1_norm[k]});
+        relevant_vertices.push_back(dof);
+        if (owned_dofs.is_element(dof))
+          interior_vertices.push_back({dof,
+                                       dual_cell_measure[dof],
+                                       stiffness_diagonal[dof],
+                                       1 / row_l1_norm[dof]});
       }
     interior_vertex_dofs.compress();
     positions.resize(interior_vertices.size());
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
-      for (unsigned int i = 0; i < 2; ++i)
-        positions[k][i] =
-          owned_dofs.index_within_set(interior_vertices[k].dof[i]);
+      positions[k] = owned_dofs.index_within_set(interior_vertices[k].dof);
   }
 
 
@@ -327,24 +290,6 @@ namespace membranes
   DiscreteProblem<dim>::locally_relevant_dofs() const
   {
     return relevant_dofs;
-  }
-
-
-
-  template <int dim>
-  const IndexSet &
-  DiscreteProblem<dim>::locally_owned_scalar_dofs() const
-  {
-    return owned_scalar_dofs;
-  }
-
-
-
-  template <int dim>
-  const IndexSet &
-  DiscreteProblem<dim>::locally_relevant_scalar_dofs() const
-  {
-    return relevant_scalar_dofs;
   }
 
 
@@ -409,7 +354,7 @@ namespace membranes
 
 
   template <int dim>
-  const std::vector<std::array<int, 2>> &
+  const std::vector<unsigned int> &
   DiscreteProblem<dim>::local_positions() const
   {
     return positions;
@@ -418,7 +363,7 @@ namespace membranes
 
 
   template <int dim>
-  const std::vector<std::array<types::global_dof_index, 2>> &
+  const std::vector<types::global_dof_index> &
   DiscreteProblem<dim>::locally_relevant_vertices() const
   {
     return relevant_vertices;

@@ -20,12 +20,12 @@ namespace membranes
   namespace
   {
     template <int dim>
-    std::unique_ptr<FESystem<dim>>
+    std::unique_ptr<FiniteElement<dim>>
     make_fe(const Parameters::CellType cell_type)
     {
       if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<FESystem<dim>>(FE_SimplexP<dim>(1), 2);
-      return std::make_unique<FESystem<dim>>(FE_Q<dim>(1), 2);
+        return std::make_unique<FE_SimplexP<dim>>(1);
+      return std::make_unique<FE_Q<dim>>(1);
     }
 
     template <int dim>

@@ -21,12 +21,13 @@ namespace membranes
 
   template <int dim>
   double
-  ErrorEstimator<dim>::residual_estimate(const DoFHandler<dim> &dof_handler,
-                                         const VectorType &ghosted_solution,
-                                         const DiscreteAction<dim> &action,
-                                         const VectorType          &lambda_h,
-                                         Vector<double>            &indicators,
-                                         const MPI_Comm mpi_communicator) const
+  ErrorEstimator<dim>::residual_estimate(
+    const DoFHandler<dim>     &dof_handler,
+    const BlockVectorType     &ghosted_solution,
+    const DiscreteAction<dim> &action,
+    const VectorType          &lambda_h,
+    Vector<double>            &indicators,
+    const MPI_Comm             mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
     add_cell_terms(dof_handler, ghosted_solution, action, lambda_h, indicators);
@@ -46,7 +47,7 @@ namespace membranes
   template <int dim>
   void
   ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
-                                      const VectorType      &ghosted_solution,
+                                      const BlockVectorType &ghosted_solution,
                                       const DiscreteAction<dim> &action,
                                       const VectorType          &lambda_h,
                                       Vector<double> &indicators) const
@@ -98,17 +99,17 @@ namespace membranes
         const FEValues<dim>       &fe_values = scratch.values.fe_values;
         const std::vector<double> &lambda    = scratch.values.lambda_h;
 
-        const double h_K     = cell->diameter();
-        double       eta2    = 0;
-        double       contact = 0;
+        const double                     h_K     = cell->diameter();
+        double                           eta2    = 0;
+        double                           contact = 0;
+        const FEValuesExtractors::Scalar scalar(0);
         for (unsigned int i = 0; i < 2; ++i)
           {
-            const FEValuesExtractors::Scalar membrane(i);
-            fe_values[membrane].get_function_values_from_local_dof_values(
-              scratch.values.local_dofs, scratch.u[i]);
+            fe_values[scalar].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.u[i]);
             if (with_laplacians)
-              fe_values[membrane].get_function_laplacians_from_local_dof_values(
-                scratch.values.local_dofs, scratch.laplacian[i]);
+              fe_values[scalar].get_function_laplacians_from_local_dof_values(
+                scratch.values.local_dofs[i], scratch.laplacian[i]);
 
             // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
             // assembly.
@@ -138,8 +139,9 @@ namespace membranes
 
   /**
    * What one thread needs on an edge between quadrilaterals: the two traces
-   * of the gradient on the edge, with matching points, from the nodal
-   * values of the cell (side 0) and of its neighbour (side 1).
+   * of the gradient of each membrane on the edge, with matching points,
+   * from the nodal values of the cell (side 0) and of its neighbour
+   * (side 1).
    */
   template <int dim>
   struct ErrorEstimator<dim>::JumpScratch
@@ -147,8 +149,9 @@ namespace membranes
     JumpScratch(const Discretization<dim> &discretization)
     {
       const FiniteElement<dim> &fe = *discretization.fe;
-      for (auto &values : local_dofs)
-        values.resize(fe.n_dofs_per_cell());
+      for (auto &membrane_values : local_dofs)
+        for (auto &values : membrane_values)
+          values.resize(fe.n_dofs_per_cell());
       if (!fe.reference_cell().is_simplex())
         interface_values =
           std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
@@ -159,9 +162,11 @@ namespace membranes
                                                      update_normal_vectors);
     }
 
-    std::unique_ptr<FEInterfaceValues<dim>>                   interface_values;
+    std::unique_ptr<FEInterfaceValues<dim>> interface_values;
+    /** traces[i][side]: ∇u_ih at the points of the edge. */
     std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
-    std::array<std::vector<double>, 2>                        local_dofs;
+    /** local_dofs[i][side]: the nodal values of u_ih on that cell. */
+    std::array<std::array<std::vector<double>, 2>, 2> local_dofs;
   };
 
 
@@ -169,7 +174,7 @@ namespace membranes
   template <int dim>
   void
   ErrorEstimator<dim>::add_jump_terms(const DoFHandler<dim> &dof_handler,
-                                      const VectorType      &ghosted_solution,
+                                      const BlockVectorType &ghosted_solution,
                                       Vector<double>        &indicators) const
   {
     const bool simplex = discretization.fe->reference_cell().is_simplex();
@@ -237,8 +242,9 @@ namespace membranes
 
   template <int dim>
   std::vector<std::array<Tensor<1, dim>, 2>>
-  ErrorEstimator<dim>::p1_gradients(const DoFHandler<dim> &dof_handler,
-                                    const VectorType &ghosted_solution) const
+  ErrorEstimator<dim>::p1_gradients(
+    const DoFHandler<dim> &dof_handler,
+    const BlockVectorType &ghosted_solution) const
   {
     const FiniteElement<dim>                  &fe = *discretization.fe;
     std::vector<std::array<Tensor<1, dim>, 2>> cell_gradients(
@@ -253,12 +259,12 @@ namespace membranes
       if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
-          cell->get_dof_values(ghosted_solution,
-                               local_dofs.begin(),
-                               local_dofs.end());
           for (unsigned int i = 0; i < 2; ++i)
             {
-              fe_values[FEValuesExtractors::Scalar(i)]
+              cell->get_dof_values(ghosted_solution.block(i),
+                                   local_dofs.begin(),
+                                   local_dofs.end());
+              fe_values[FEValuesExtractors::Scalar(0)]
                 .get_function_gradients_from_local_dof_values(local_dofs,
                                                               gradient);
               cell_gradients[cell->active_cell_index()][i] = gradient[0];
@@ -300,10 +306,11 @@ namespace membranes
 
   template <int dim>
   std::array<double, 2>
-  ErrorEstimator<dim>::q1_jump_integrals(const CellIterator &cell,
-                                         const unsigned int  f,
-                                         const VectorType   &ghosted_solution,
-                                         JumpScratch        &scratch) const
+  ErrorEstimator<dim>::q1_jump_integrals(
+    const CellIterator    &cell,
+    const unsigned int     f,
+    const BlockVectorType &ghosted_solution,
+    JumpScratch           &scratch) const
   {
     FEInterfaceValues<dim> &interface_values = *scratch.interface_values;
     const auto             &neighbor         = cell->neighbor(f);
@@ -320,24 +327,25 @@ namespace membranes
                               neighbor,
                               cell->neighbor_of_neighbor(f),
                               numbers::invalid_unsigned_int);
-    cell->get_dof_values(ghosted_solution,
-                         scratch.local_dofs[0].begin(),
-                         scratch.local_dofs[0].end());
-    neighbor->get_dof_values(ghosted_solution,
-                             scratch.local_dofs[1].begin(),
-                             scratch.local_dofs[1].end());
     const unsigned int    n_q = interface_values.n_quadrature_points;
     std::array<double, 2> integrals{};
     for (unsigned int i = 0; i < 2; ++i)
       {
-        auto &traces = scratch.traces[i];
+        auto &traces     = scratch.traces[i];
+        auto &local_dofs = scratch.local_dofs[i];
+        cell->get_dof_values(ghosted_solution.block(i),
+                             local_dofs[0].begin(),
+                             local_dofs[0].end());
+        neighbor->get_dof_values(ghosted_solution.block(i),
+                                 local_dofs[1].begin(),
+                                 local_dofs[1].end());
         for (unsigned int side = 0; side < 2; ++side)
           {
             traces[side].resize(n_q);
             interface_values
-              .get_fe_face_values(side)[FEValuesExtractors::Scalar(i)]
-              .get_function_gradients_from_local_dof_values(
-                scratch.local_dofs[side], traces[side]);
+              .get_fe_face_values(side)[FEValuesExtractors::Scalar(0)]
+              .get_function_gradients_from_local_dof_values(local_dofs[side],
+                                                            traces[side]);
           }
         for (unsigned int q = 0; q < n_q; ++q)
           integrals[i] += std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
@@ -414,7 +422,7 @@ namespace membranes
   typename ErrorEstimator<dim>::FluxEstimate
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>        &dof_handler,
-    const VectorType             &ghosted_solution,
+    const BlockVectorType        &ghosted_solution,
     const DiscreteAction<dim>    &action,
     const VectorType             &lambda_h,
     const FluxEquilibration<dim> &flux_equilibration,
@@ -462,7 +470,7 @@ namespace membranes
   typename ErrorEstimator<dim>::FluxTerms
   ErrorEstimator<dim>::flux_terms(
     const CellIterator           &cell,
-    const VectorType             &ghosted_solution,
+    const BlockVectorType        &ghosted_solution,
     const DiscreteAction<dim>    &action,
     const FluxEquilibration<dim> &flux_equilibration,
     FluxScratch                  &scratch) const
@@ -472,16 +480,16 @@ namespace membranes
     action.nodal_lambda_values(fe_values,
                                scratch.values.nodal_lambda_h,
                                scratch.lambda);
-    const std::array<double, 2> sign{{1., -1.}};
-    const double                h_K = cell->diameter();
-    FluxTerms                   terms;
+    const std::array<double, 2>      sign{{1., -1.}};
+    const double                     h_K = cell->diameter();
+    const FEValuesExtractors::Scalar scalar(0);
+    FluxTerms                        terms;
     for (unsigned int i = 0; i < 2; ++i)
       {
-        const FEValuesExtractors::Scalar membrane(i);
-        fe_values[membrane].get_function_values_from_local_dof_values(
-          scratch.values.local_dofs, scratch.u[i]);
-        fe_values[membrane].get_function_gradients_from_local_dof_values(
-          scratch.values.local_dofs, scratch.grad_u[i]);
+        fe_values[scalar].get_function_values_from_local_dof_values(
+          scratch.values.local_dofs[i], scratch.u[i]);
+        fe_values[scalar].get_function_gradients_from_local_dof_values(
+          scratch.values.local_dofs[i], scratch.grad_u[i]);
         flux_equilibration.flux_values(
           cell, i, fe_values, scratch.flux, scratch.divergence);
         const auto load =
@@ -513,37 +521,43 @@ namespace membranes
 
   template <int dim>
   double
-  ErrorEstimator<dim>::boundary_data_part(const DoFHandler<dim> &dof_handler,
-                                          const VectorType &ghosted_solution,
-                                          const MPI_Comm mpi_communicator) const
+  ErrorEstimator<dim>::boundary_data_part(
+    const DoFHandler<dim> &dof_handler,
+    const BlockVectorType &ghosted_solution,
+    const MPI_Comm         mpi_communicator) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
     const Quadrature<dim - 1> quadrature =
       fe.reference_cell().is_simplex() ?
         Quadrature<dim - 1>(QGaussSimplex<dim - 1>(3)) :
         Quadrature<dim - 1>(QGauss<dim - 1>(3));
-    FEFaceValues<dim>           face_values(*discretization.mapping,
+    FEFaceValues<dim> face_values(*discretization.mapping,
                                   fe,
                                   quadrature,
                                   update_values | update_quadrature_points |
                                     update_JxW_values);
-    std::vector<Vector<double>> u(quadrature.size(), Vector<double>(2)),
-      g(quadrature.size(), Vector<double>(2));
-    double sum = 0;
+
+    std::array<std::vector<double>, 2> u;
+    for (auto &values : u)
+      values.resize(quadrature.size());
+    std::vector<Vector<double>> g(quadrature.size(), Vector<double>(2));
+    double                      sum = 0;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned() && cell->at_boundary())
         for (const unsigned int f : cell->face_indices())
           if (cell->at_boundary(f))
             {
               face_values.reinit(cell, f);
-              face_values.get_function_values(ghosted_solution, u);
+              for (unsigned int i = 0; i < 2; ++i)
+                face_values.get_function_values(ghosted_solution.block(i),
+                                                u[i]);
               data.boundary_values().vector_value_list(
                 face_values.get_quadrature_points(), g);
               double integral = 0;
               for (const unsigned int q :
                    face_values.quadrature_point_indices())
                 for (unsigned int i = 0; i < 2; ++i)
-                  integral += data.mu[i] * std::pow(g[q][i] - u[q][i], 2) *
+                  integral += data.mu[i] * std::pow(g[q][i] - u[i][q], 2) *
                               face_values.JxW(q);
               sum += integral / cell->face(f)->measure();
             }

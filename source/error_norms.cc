@@ -18,7 +18,7 @@ namespace membranes
   template <int dim>
   typename ErrorNorms<dim>::Errors
   ErrorNorms<dim>::compute(const DoFHandler<dim>     &dof_handler,
-                           const VectorType          &ghosted_solution,
+                           const BlockVectorType     &ghosted_solution,
                            const DiscreteAction<dim> &action,
                            const VectorType          &lambda_h,
                            const MPI_Comm             mpi_communicator) const
@@ -68,13 +68,13 @@ namespace membranes
         const FEValues<dim> &fe_values = scratch.values.fe_values;
         data.set_gradient_step(1e-4 * cell->diameter());
         const auto &points = fe_values.get_quadrature_points();
+        const FEValuesExtractors::Scalar scalar(0);
         for (unsigned int i = 0; i < 2; ++i)
           {
-            const FEValuesExtractors::Scalar membrane(i);
-            fe_values[membrane].get_function_values_from_local_dof_values(
-              scratch.values.local_dofs, scratch.uh[i]);
-            fe_values[membrane].get_function_gradients_from_local_dof_values(
-              scratch.values.local_dofs, scratch.grad_uh[i]);
+            fe_values[scalar].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.uh[i]);
+            fe_values[scalar].get_function_gradients_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.grad_uh[i]);
           }
         data.exact_solution_list(points, scratch.exact);
         const auto &exact = scratch.exact;

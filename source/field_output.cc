@@ -2,8 +2,8 @@
 #include <array>
 #include <cmath>
 #include <deal.II/base/mpi.h>
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/numerics/data_out.h>
-#include <deal.II/numerics/data_postprocessor.h>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -12,31 +12,6 @@
 
 namespace membranes
 {
-  namespace
-  {
-    /** w = u1 − u2 from the two components of the solution. */
-    template <int dim>
-    class WPostprocessor : public DataPostprocessorScalar<dim>
-    {
-    public:
-      WPostprocessor()
-        : DataPostprocessorScalar<dim>("w", update_values)
-      {}
-
-      void
-      evaluate_vector_field(
-        const DataPostprocessorInputs::Vector<dim> &inputs,
-        std::vector<Vector<double>> &computed_quantities) const override
-      {
-        for (unsigned int q = 0; q < inputs.solution_values.size(); ++q)
-          computed_quantities[q](0) =
-            inputs.solution_values[q](0) - inputs.solution_values[q](1);
-      }
-    };
-  } // namespace
-
-
-
   template <int dim>
   FieldOutput<dim>::FieldOutput(const Parameters::Output  &parameters,
                                 const Discretization<dim> &discretization,
@@ -52,21 +27,50 @@ namespace membranes
   std::vector<std::string>
   FieldOutput<dim>::write(const unsigned int     cycle,
                           const DoFHandler<dim> &dof_handler,
-                          const VectorType      &ghosted_solution,
-                          const VectorType      &lambda_and_active_flags,
+                          const BlockVectorType &ghosted_solution,
+                          const VectorType      &lambda_h,
+                          const IndexSet        &active_vertices,
                           const Vector<double>  *indicators)
   {
     std::vector<std::string> files;
+    if (!parameters.write_vtu && !parameters.write_nodal_values)
+      return files;
+    const Fields fields =
+      make_fields(dof_handler, ghosted_solution, active_vertices);
     if (parameters.write_vtu)
-      files.push_back(write_vtu(cycle,
-                                dof_handler,
-                                ghosted_solution,
-                                lambda_and_active_flags,
-                                indicators));
+      files.push_back(write_vtu(
+        cycle, dof_handler, ghosted_solution, lambda_h, fields, indicators));
     if (parameters.write_nodal_values)
       files.push_back(write_nodal_values(
-        cycle, dof_handler, ghosted_solution, lambda_and_active_flags));
+        cycle, dof_handler, ghosted_solution, lambda_h, fields));
     return files;
+  }
+
+
+
+  template <int dim>
+  typename FieldOutput<dim>::Fields
+  FieldOutput<dim>::make_fields(const DoFHandler<dim> &dof_handler,
+                                const BlockVectorType &ghosted_solution,
+                                const IndexSet        &active_vertices) const
+  {
+    const IndexSet &owned_dofs = dof_handler.locally_owned_dofs();
+    VectorType      w(owned_dofs, mpi_communicator);
+    for (const types::global_dof_index dof : owned_dofs)
+      w[dof] = ghosted_solution.block(0)[dof] - ghosted_solution.block(1)[dof];
+    w.compress(VectorOperation::insert);
+    VectorType active_set(owned_dofs, mpi_communicator);
+    for (const types::global_dof_index dof : active_vertices)
+      active_set[dof] = 1;
+    active_set.compress(VectorOperation::insert);
+
+    const IndexSet relevant_dofs =
+      DoFTools::extract_locally_relevant_dofs(dof_handler);
+    Fields fields{VectorType(owned_dofs, relevant_dofs, mpi_communicator),
+                  VectorType(owned_dofs, relevant_dofs, mpi_communicator)};
+    fields.w          = w;
+    fields.active_set = active_set;
+    return fields;
   }
 
 
@@ -75,24 +79,28 @@ namespace membranes
   std::string
   FieldOutput<dim>::write_vtu(const unsigned int     cycle,
                               const DoFHandler<dim> &dof_handler,
-                              const VectorType      &ghosted_solution,
-                              const VectorType      &lambda_and_active_flags,
+                              const BlockVectorType &ghosted_solution,
+                              const VectorType      &lambda_h,
+                              const Fields          &fields,
                               const Vector<double>  *indicators)
   {
-    const WPostprocessor<dim> w;
-    DataOut<dim>              data_out;
+    // The types are given: on a mesh with as many vertices as cells, the
+    // automatic choice could not tell nodal from cell data.
+    constexpr auto nodal = DataOut<dim>::type_dof_data;
+    DataOut<dim>   data_out;
     data_out.attach_dof_handler(dof_handler);
-    data_out.add_data_vector(ghosted_solution,
-                             std::vector<std::string>{"u1", "u2"});
-    data_out.add_data_vector(ghosted_solution, w);
-    data_out.add_data_vector(lambda_and_active_flags,
-                             std::vector<std::string>{"lambda_h",
-                                                      "active_set"});
+    data_out.add_data_vector(ghosted_solution.block(0), "u1", nodal);
+    data_out.add_data_vector(ghosted_solution.block(1), "u2", nodal);
+    data_out.add_data_vector(fields.w, "w", nodal);
+    data_out.add_data_vector(lambda_h, "lambda_h", nodal);
+    data_out.add_data_vector(fields.active_set, "active_set", nodal);
     const auto   &triangulation = dof_handler.get_triangulation();
     Vector<float> subdomain(triangulation.n_active_cells());
     for (float &value : subdomain)
       value = triangulation.locally_owned_subdomain();
-    data_out.add_data_vector(subdomain, "subdomain");
+    data_out.add_data_vector(subdomain,
+                             "subdomain",
+                             DataOut<dim>::type_cell_data);
     Vector<double> eta_K;
     if (indicators)
       {
@@ -188,30 +196,29 @@ namespace membranes
 
   template <int dim>
   std::string
-  FieldOutput<dim>::write_nodal_values(
-    const unsigned int     cycle,
-    const DoFHandler<dim> &dof_handler,
-    const VectorType      &ghosted_solution,
-    const VectorType      &lambda_and_active_flags) const
+  FieldOutput<dim>::write_nodal_values(const unsigned int     cycle,
+                                       const DoFHandler<dim> &dof_handler,
+                                       const BlockVectorType &ghosted_solution,
+                                       const VectorType      &lambda_h,
+                                       const Fields          &fields) const
   {
-    // The locally owned vertices, each once (by its u1 DoF), with their
+    // The locally owned vertices, each once (by its DoF), with their
     // values: x, y, u1, u2, λ_a, active set.
-    using Row                 = std::array<double, 6>;
-    const IndexSet owned_dofs = ghosted_solution.locally_owned_elements();
+    using Row                  = std::array<double, 6>;
+    const IndexSet &owned_dofs = dof_handler.locally_owned_dofs();
     std::map<types::global_dof_index, Row> owned_rows;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         for (const unsigned int v : cell->vertex_indices())
           {
-            const auto u1_dof = cell->vertex_dof_index(v, 0);
-            const auto u2_dof = cell->vertex_dof_index(v, 1);
-            if (owned_dofs.is_element(u1_dof))
-              owned_rows[u1_dof] = {{cell->vertex(v)[0],
-                                     cell->vertex(v)[1],
-                                     ghosted_solution[u1_dof],
-                                     ghosted_solution[u2_dof],
-                                     lambda_and_active_flags[u1_dof],
-                                     lambda_and_active_flags[u2_dof]}};
+            const auto dof = cell->vertex_dof_index(v, 0);
+            if (owned_dofs.is_element(dof))
+              owned_rows[dof] = {{cell->vertex(v)[0],
+                                  cell->vertex(v)[1],
+                                  ghosted_solution.block(0)[dof],
+                                  ghosted_solution.block(1)[dof],
+                                  lambda_h[dof],
+                                  fields.active_set[dof]}};
           }
     std::vector<Row> rows;
     for (const auto &[dof, row] : owned_rows)

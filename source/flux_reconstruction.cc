@@ -75,6 +75,7 @@ namespace membranes
                   points.quadrature,
                   update_values | update_gradients | update_jacobians |
                     update_quadrature_points | update_JxW_values)
+      , local_dofs(discretization.fe->n_dofs_per_cell())
       , volume_points(points.n_volume)
     {
       for (auto &gradient : gradients)
@@ -83,6 +84,8 @@ namespace membranes
 
     const SubTrianglePoints<dim> &points;
     FEValues<dim>                 fe_values;
+    /** The nodal values of one membrane on the cell. */
+    std::vector<double> local_dofs;
     /** ∇u_ih at the points. */
     std::array<std::vector<Tensor<1, dim>>, 2> gradients;
     std::vector<Point<dim>>                    volume_points;
@@ -146,7 +149,7 @@ namespace membranes
   template <int dim>
   AlignedVector<typename FluxReconstruction<dim>::PatchTerms>
   FluxReconstruction<dim>::reconstruct(const DoFHandler<dim> &dof_handler,
-                                       const VectorType      &ghosted_solution)
+                                       const BlockVectorType &ghosted_solution)
   {
     this->dof_handler = &dof_handler;
     const unsigned int n_cells =
@@ -183,7 +186,7 @@ namespace membranes
   template <int dim>
   typename FluxReconstruction<dim>::HalfEdgeMinimization
   FluxReconstruction<dim>::compute_local_fluxes(
-    const VectorType          &ghosted_solution,
+    const BlockVectorType     &ghosted_solution,
     AlignedVector<PatchTerms> &patch_terms)
   {
     const unsigned int   n_entries = sub_triangle_data.size();
@@ -217,7 +220,7 @@ namespace membranes
   void
   FluxReconstruction<dim>::local_fluxes_on_cell(
     const CellIterator        &cell,
-    const VectorType          &ghosted_solution,
+    const BlockVectorType     &ghosted_solution,
     AlignedVector<PatchTerms> &patch_terms,
     LocalFluxScratch          &scratch,
     LocalFluxCopy             &copy)
@@ -236,9 +239,17 @@ namespace membranes
     copy.cell = cell->active_cell_index();
     copy.half_edges.resize(n_triangles);
     scratch.fe_values.reinit(cell);
+    // ∇u_ih from the nodal values of block i, read into the buffer of the
+    // scratch.
     for (unsigned int i = 0; i < 2; ++i)
-      scratch.fe_values[FEValuesExtractors::Scalar(i)].get_function_gradients(
-        ghosted_solution, scratch.gradients[i]);
+      {
+        cell->get_dof_values(ghosted_solution.block(i),
+                             scratch.local_dofs.begin(),
+                             scratch.local_dofs.end());
+        scratch.fe_values[FEValuesExtractors::Scalar(0)]
+          .get_function_gradients_from_local_dof_values(scratch.local_dofs,
+                                                        scratch.gradients[i]);
+      }
     for (unsigned int q = 0; q < n_volume; ++q)
       scratch.volume_points[q] = scratch.fe_values.quadrature_point(q);
     data.load_list(scratch.volume_points, scratch.load);
@@ -365,15 +376,16 @@ namespace membranes
             }
           for (unsigned int i = 0; i < 2; ++i)
             kappa.load[i] += scratch.loads[i][q] * JxW;
+          // The hat function of vertex v is shape function v of the P1/Q1
+          // element.
           for (unsigned int v = 0; v < n_vertices; ++v)
             {
-              const unsigned int k   = fe.component_to_system_index(0, v);
-              const double       phi = fe_values.shape_value(k, q);
+              const double phi = fe_values.shape_value(v, q);
               terms.hat_mass[v] += phi * JxW;
               for (unsigned int i = 0; i < 2; ++i)
                 terms.hat_residual[i][v] +=
                   (scratch.loads[i][q] * phi -
-                   data.mu[i] * gradients[i][q] * fe_values.shape_grad(k, q)) *
+                   data.mu[i] * gradients[i][q] * fe_values.shape_grad(v, q)) *
                   JxW;
             }
         }
@@ -519,19 +531,25 @@ namespace membranes
     const auto               &triangles   = basis.sub_triangles();
     const unsigned int        n_triangles = triangles.size();
 
-    // Per cell and vertex v the measure of K ∩ D_v, the integral of div t_ih
-    // over it, f_ih meas(K ∩ D_v) and f_ih ∫_K φ_v, condensed like d_a with
-    // the hanging node constraints.
+    // Per cell and vertex v the measure of K ∩ D_v and, in block i, the
+    // integral of div t_ih over it, f_ih meas(K ∩ D_v) and f_ih ∫_K φ_v,
+    // condensed like d_a with the hanging node constraints. The hat
+    // function of vertex v is shape function v of the P1/Q1 element.
     DualCellSums sums;
-    for (auto *vector : {&sums.measure,
-                         &sums.divergence,
-                         &sums.load_on_pieces,
-                         &sums.load_on_hats})
-      vector->reinit(locally_owned_dofs, mpi_communicator);
-    const unsigned int dofs_per_cell = fe.n_dofs_per_cell();
-    Vector<double>     local_measure(dofs_per_cell),
-      local_divergence(dofs_per_cell), local_load_on_pieces(dofs_per_cell),
-      local_load_on_hats(dofs_per_cell);
+    sums.measure.reinit(locally_owned_dofs, mpi_communicator);
+    for (auto *vector :
+         {&sums.divergence, &sums.load_on_pieces, &sums.load_on_hats})
+      vector->reinit(std::vector<IndexSet>(2, locally_owned_dofs),
+                     mpi_communicator);
+    const unsigned int            dofs_per_cell = fe.n_dofs_per_cell();
+    Vector<double>                local_measure(dofs_per_cell);
+    std::array<Vector<double>, 2> local_divergence, local_load_on_pieces,
+      local_load_on_hats;
+    for (unsigned int i = 0; i < 2; ++i)
+      for (auto *local : {&local_divergence[i],
+                          &local_load_on_pieces[i],
+                          &local_load_on_hats[i]})
+        local->reinit(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
     for (const auto &cell : dof_handler->active_cell_iterators())
       if (cell->is_locally_owned())
@@ -548,44 +566,46 @@ namespace membranes
               for (unsigned int i = 0; i < 2; ++i)
                 load_mean[i] += kappa[s].load[i];
             }
-          local_measure    = 0;
-          local_divergence = 0;
+          local_measure = 0;
+          for (unsigned int i = 0; i < 2; ++i)
+            local_divergence[i] = 0;
           for (unsigned int s = 0; s < n_triangles; ++s)
-            for (unsigned int i = 0; i < 2; ++i)
-              {
-                const auto k =
-                  fe.component_to_system_index(i, triangles[s].vertex);
-                local_measure(k) += kappa[s].area;
-                local_divergence(k) += kappa[s].fluxes[i][0] +
-                                       kappa[s].fluxes[i][1] +
-                                       kappa[s].fluxes[i][2];
-              }
+            {
+              const unsigned int v = triangles[s].vertex;
+              local_measure(v) += kappa[s].area;
+              for (unsigned int i = 0; i < 2; ++i)
+                local_divergence[i](v) += kappa[s].fluxes[i][0] +
+                                          kappa[s].fluxes[i][1] +
+                                          kappa[s].fluxes[i][2];
+            }
           for (const unsigned int v : cell->vertex_indices())
             for (unsigned int i = 0; i < 2; ++i)
               {
-                const auto k = fe.component_to_system_index(i, v);
-                local_load_on_pieces(k) =
-                  load_mean[i] / area * local_measure(k);
+                local_load_on_pieces[i](v) =
+                  load_mean[i] / area * local_measure(v);
                 // f_ih ∫_K φ_v.
-                local_load_on_hats(k) =
+                local_load_on_hats[i](v) =
                   load_mean[i] / area *
                   hat_integrals[cell->active_cell_index()][v];
               }
           hanging_node_constraints.distribute_local_to_global(local_measure,
                                                               dof_indices,
                                                               sums.measure);
-          hanging_node_constraints.distribute_local_to_global(local_divergence,
-                                                              dof_indices,
-                                                              sums.divergence);
-          hanging_node_constraints.distribute_local_to_global(
-            local_load_on_pieces, dof_indices, sums.load_on_pieces);
-          hanging_node_constraints.distribute_local_to_global(
-            local_load_on_hats, dof_indices, sums.load_on_hats);
+          for (unsigned int i = 0; i < 2; ++i)
+            {
+              hanging_node_constraints.distribute_local_to_global(
+                local_divergence[i], dof_indices, sums.divergence.block(i));
+              hanging_node_constraints.distribute_local_to_global(
+                local_load_on_pieces[i],
+                dof_indices,
+                sums.load_on_pieces.block(i));
+              hanging_node_constraints.distribute_local_to_global(
+                local_load_on_hats[i], dof_indices, sums.load_on_hats.block(i));
+            }
         }
-    for (auto *vector : {&sums.measure,
-                         &sums.divergence,
-                         &sums.load_on_pieces,
-                         &sums.load_on_hats})
+    sums.measure.compress(VectorOperation::add);
+    for (auto *vector :
+         {&sums.divergence, &sums.load_on_pieces, &sums.load_on_hats})
       vector->compress(VectorOperation::add);
     return sums;
   }
@@ -607,27 +627,27 @@ namespace membranes
     const auto &vertices = action.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto &a = vertices[k];
+        const auto &a   = vertices[k];
+        const auto  dof = a.dof;
         defects.measure_defect =
           std::max(defects.measure_defect,
-                   std::abs(measure[a.dof[0]] - a.dual_cell_measure) /
+                   std::abs(measure[dof] - a.dual_cell_measure) /
                      a.dual_cell_measure);
         for (unsigned int i = 0; i < 2; ++i)
           {
-            const auto   dof  = a.dof[i];
-            const double sign = (i == 0 ? 1. : -1.);
+            const double sign             = (i == 0 ? 1. : -1.);
+            const double divergence_i     = divergence.block(i)[dof];
+            const double load_on_pieces_i = load_on_pieces.block(i)[dof];
             defects.conservation_defect =
               std::max(defects.conservation_defect,
-                       std::abs(divergence[dof] - action.stiffness_term(i, k)));
+                       std::abs(divergence_i - action.stiffness_term(i, k)));
             // ∫ (f_i − f_ih) φ_a with the assembly's ∫ f_i φ_a.
             const double oscillation =
-              action.load_term(i, k) - load_on_hats[dof];
-            defects.balance_defect =
-              std::max(defects.balance_defect,
-                       std::abs(sign * action.lambda_from_membrane(i, k) *
-                                  measure[a.dof[0]] -
-                                (divergence[dof] - load_on_pieces[dof] -
-                                 oscillation)));
+              action.load_term(i, k) - load_on_hats.block(i)[dof];
+            defects.balance_defect = std::max(
+              defects.balance_defect,
+              std::abs(sign * action.lambda_from_membrane(i, k) * measure[dof] -
+                       (divergence_i - load_on_pieces_i - oscillation)));
           }
       }
     const double force_scale =

@@ -41,7 +41,8 @@ namespace membranes
     , reconstruction_points(dual, false)
   {
     // The hat functions of the cell's vertices at the Gauss points of the
-    // edges of the sub-triangles (reference values).
+    // edges of the sub-triangles (reference values): that of vertex v is
+    // shape function v of the P1/Q1 element.
     const SubTrianglePoints<dim> &points = reconstruction_points;
     for (unsigned int s = 0; s < n_sub_triangles(); ++s)
       for (unsigned int e = 0; e < 3; ++e)
@@ -50,9 +51,8 @@ namespace membranes
                ++v)
             edge_shape_values.push_back(
               v < fe.reference_cell().n_vertices() ?
-                fe.shape_value(fe.component_to_system_index(0, v),
-                               points.quadrature.point(
-                                 points.edge_point(s, e, k))) :
+                fe.shape_value(
+                  v, points.quadrature.point(points.edge_point(s, e, k))) :
                 0.);
 
     // The Raviart–Thomas basis and the rotations of each sub-triangle at its

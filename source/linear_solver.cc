@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
-#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/lac/trilinos_solver.h>
@@ -20,17 +19,16 @@ namespace membranes
 
   template <int dim>
   void
-  LinearSolver<dim>::reinit(const DoFHandler<dim> &dof_handler)
+  LinearSolver<dim>::reinit(
+    const types::global_dof_index         n_unknowns,
+    const std::vector<std::vector<bool>> &constant_modes)
   {
     const bool serial =
       (Utilities::MPI::n_mpi_processes(mpi_communicator) == 1);
     use_direct = (type == Parameters::LinearSolverType::direct) ||
                  (type == Parameters::LinearSolverType::automatic && serial &&
-                  dof_handler.n_dofs() <= direct_solver_dof_limit);
-    if (!use_direct)
-      DoFTools::extract_constant_modes(dof_handler,
-                                       ComponentMask(),
-                                       constant_modes);
+                  n_unknowns <= direct_solver_dof_limit);
+    this->constant_modes = constant_modes;
     amg.reset();
   }
 

@@ -27,7 +27,6 @@ namespace membranes
     , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
                                             mpi_communicator))
     , dof_handler(*triangulation)
-    , scalar_dof_handler(*triangulation)
     , discrete_problem(discretization, data)
     , active_set(parameters.solver, discretization, data, mpi_communicator)
     , action(discretization, data)
@@ -163,44 +162,41 @@ namespace membranes
 
 
   /**
-   * DoFs of (u1, u2), the index sets of the step-40 layout, the hanging node
-   * constraints, and the discrete problem of the mesh (DiscreteProblem: the
-   * Laplacian, the loads, the vertices of the dual mesh), which the discrete
-   * action and the solver's systems read.
+   * The DoFs of the mesh (one per vertex), the hanging node constraints,
+   * and the discrete problem of the mesh (DiscreteProblem: the index sets of
+   * the step-40 layout, the Laplacian, the loads, the vertices of the dual
+   * mesh), which the discrete action and the solver's systems read. The
+   * vectors of the mesh: the two blocks (u1h, u2h) of the solution, and
+   * λ_h.
    */
   template <int dim>
   void
   MembraneProblem<dim>::setup_system()
   {
     dof_handler.distribute_dofs(*discretization.fe);
-    locally_owned_dofs = dof_handler.locally_owned_dofs();
-    DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
 
+    IndexSet locally_relevant_dofs;
+    DoFTools::extract_locally_relevant_dofs(dof_handler, locally_relevant_dofs);
     hanging_node_constraints.clear();
     hanging_node_constraints.reinit(locally_relevant_dofs);
     DoFTools::make_hanging_node_constraints(dof_handler,
                                             hanging_node_constraints);
     hanging_node_constraints.close();
 
-    scalar_dof_handler.distribute_dofs(discretization.fe->base_element(0));
-
     discrete_problem.reinit(dof_handler,
                             hanging_node_constraints,
-                            scalar_dof_handler,
                             mpi_communicator);
     action.reinit(discrete_problem);
     active_set_solver.setup(discrete_problem,
                             dof_handler,
-                            hanging_node_constraints,
-                            scalar_dof_handler);
+                            hanging_node_constraints);
 
-    solution.reinit(locally_owned_dofs, mpi_communicator);
-    ghosted_solution.reinit(locally_owned_dofs,
-                            locally_relevant_dofs,
+    const IndexSet &owned = discrete_problem.locally_owned_dofs();
+    solution.reinit(std::vector<IndexSet>(2, owned), mpi_communicator);
+    ghosted_solution.reinit(std::vector<IndexSet>(2, owned),
+                            std::vector<IndexSet>(2, locally_relevant_dofs),
                             mpi_communicator);
-    lambda_h.reinit(locally_owned_dofs,
-                    locally_relevant_dofs,
-                    mpi_communicator);
+    lambda_h.reinit(owned, locally_relevant_dofs, mpi_communicator);
   }
 
 
@@ -221,24 +217,25 @@ namespace membranes
         return;
       }
 
-    std::vector<VectorType> interpolated(2,
-                                         VectorType(locally_owned_dofs,
-                                                    mpi_communicator));
+    // u1h, u2h into the blocks of the solution, λ_h through a vector of the
+    // locally owned DoFs.
+    const IndexSet           &owned = discrete_problem.locally_owned_dofs();
+    VectorType                owned_lambda_h(owned, mpi_communicator);
+    std::vector<VectorType *> targets{&solution.block(0),
+                                      &solution.block(1),
+                                      &owned_lambda_h};
     if (distributed_transfer)
-      {
-        std::vector<VectorType *> targets{&interpolated[0], &interpolated[1]};
-        distributed_transfer->interpolate(targets);
-      }
+      distributed_transfer->interpolate(targets);
     else
       {
         std::vector<Vector<double>> replicated(
-          2, Vector<double>(dof_handler.n_dofs()));
+          targets.size(), Vector<double>(dof_handler.n_dofs()));
         serial_transfer->interpolate(replicated_previous_vectors, replicated);
-        for (unsigned int v = 0; v < 2; ++v)
+        for (unsigned int v = 0; v < targets.size(); ++v)
           {
-            for (const auto i : locally_owned_dofs)
-              interpolated[v][i] = replicated[v][i];
-            interpolated[v].compress(VectorOperation::insert);
+            for (const auto i : owned)
+              (*targets[v])[i] = replicated[v][i];
+            targets[v]->compress(VectorOperation::insert);
           }
       }
     distributed_transfer.reset();
@@ -246,11 +243,10 @@ namespace membranes
     previous_mesh_vectors.clear();
     replicated_previous_vectors.clear();
 
-    for (auto &vector : interpolated)
-      hanging_node_constraints.distribute(vector);
-    solution         = interpolated[0];
-    ghosted_solution = interpolated[0];
-    lambda_h         = interpolated[1];
+    for (VectorType *vector : targets)
+      hanging_node_constraints.distribute(*vector);
+    ghosted_solution = solution;
+    lambda_h         = owned_lambda_h;
     active_set.reinit(discrete_problem, solution, lambda_h);
   }
 
@@ -285,8 +281,12 @@ namespace membranes
                0.;
     try
       {
-        statistics =
-          active_set_solver.solve(action, solution, active_set, expected_error);
+        statistics = active_set_solver.solve(discrete_problem,
+                                             dof_handler,
+                                             action,
+                                             solution,
+                                             active_set,
+                                             expected_error);
       }
     catch (const ActiveSetNotConverged &error)
       {
@@ -443,14 +443,14 @@ namespace membranes
       flux_reconstruction->reconstruct(dof_handler, ghosted_solution),
       lambda_h,
       hanging_node_constraints,
-      locally_owned_dofs,
+      discrete_problem.locally_owned_dofs(),
       mpi_communicator);
     FluxRecord flux;
     if (parameters.output.flux_reconstruction)
       {
         const auto identities =
           flux_reconstruction->identities(hanging_node_constraints,
-                                          locally_owned_dofs,
+                                          discrete_problem.locally_owned_dofs(),
                                           mpi_communicator);
         flux.measure_defect      = identities.measure_defect;
         flux.conservation_defect = identities.conservation_defect;
@@ -501,7 +501,8 @@ namespace membranes
         .write(record.mesh.cycle,
                dof_handler,
                ghosted_solution,
-               active_set.lambda_and_flags(lambda_h),
+               lambda_h,
+               active_set.locally_owned(),
                nullptr);
     return "the last iterate is in " + output.directory + " (" + files[0] +
            ", " + files[1] + "), not in the report";
@@ -522,7 +523,8 @@ namespace membranes
     field_output.write(cycle,
                        dof_handler,
                        ghosted_solution,
-                       active_set.lambda_and_flags(lambda_h),
+                       lambda_h,
+                       active_set.locally_owned(),
                        indicators.size() ? &indicators : nullptr);
     if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
@@ -619,20 +621,26 @@ namespace membranes
 
     if (distributed_triangulation)
       {
-        previous_mesh_vectors = {ghosted_solution, lambda_h};
+        previous_mesh_vectors = {ghosted_solution.block(0),
+                                 ghosted_solution.block(1),
+                                 lambda_h};
         distributed_transfer  = std::make_unique<
           parallel::distributed::SolutionTransfer<dim, VectorType>>(
           dof_handler);
         distributed_transfer->prepare_for_coarsening_and_refinement(
-          {&previous_mesh_vectors[0], &previous_mesh_vectors[1]});
+          {&previous_mesh_vectors[0],
+           &previous_mesh_vectors[1],
+           &previous_mesh_vectors[2]});
       }
     else
       {
         // The whole mesh on every process: the serial SolutionTransfer
         // interpolates on every cell, so it reads vectors with every entry
         // (the copy from a distributed vector gathers them).
-        replicated_previous_vectors = {Vector<double>(ghosted_solution),
-                                       Vector<double>(lambda_h)};
+        replicated_previous_vectors = {
+          Vector<double>(ghosted_solution.block(0)),
+          Vector<double>(ghosted_solution.block(1)),
+          Vector<double>(lambda_h)};
         serial_transfer =
           std::make_unique<SolutionTransfer<dim, Vector<double>>>(dof_handler);
         serial_transfer->prepare_for_coarsening_and_refinement(
@@ -720,18 +728,19 @@ namespace membranes
         if (cycle > 0)
           refine_grid();
         setup_system();
-        const auto max_dofs = parameters.refinement.max_dofs;
-        if (max_dofs > 0 && dof_handler.n_dofs() > max_dofs)
+        // The DoFs of the pair (u1h, u2h): both blocks of the solution.
+        const types::global_dof_index n_dofs   = solution.size();
+        const auto                    max_dofs = parameters.refinement.max_dofs;
+        if (max_dofs > 0 && n_dofs > max_dofs)
           {
             if (cycle == 0)
-              throw Parameters::invalid_entry(
-                "Refinement/Max dofs",
-                std::to_string(max_dofs),
-                "the first mesh already has " +
-                  std::to_string(dof_handler.n_dofs()) + " DoFs");
-            pcout << "Stopping: the next mesh would have "
-                  << dof_handler.n_dofs() << " DoFs > Max dofs = " << max_dofs
-                  << std::endl;
+              throw Parameters::invalid_entry("Refinement/Max dofs",
+                                              std::to_string(max_dofs),
+                                              "the first mesh already has " +
+                                                std::to_string(n_dofs) +
+                                                " DoFs");
+            pcout << "Stopping: the next mesh would have " << n_dofs
+                  << " DoFs > Max dofs = " << max_dofs << std::endl;
             break;
           }
         transfer_solution();
@@ -739,7 +748,7 @@ namespace membranes
         record.mesh = {cycle,
                        triangulation->n_global_active_cells(),
                        triangulation->n_global_levels(),
-                       dof_handler.n_dofs()};
+                       n_dofs};
         pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
               << record.mesh.dofs << " DoFs";
         if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)

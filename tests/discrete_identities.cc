@@ -223,7 +223,6 @@ namespace
       , discretization(cell_type)
       , triangulation(make_triangulation<dim>(cell_type, mpi_communicator))
       , dof_handler(*triangulation)
-      , scalar_dof_handler(*triangulation)
       , discrete_problem(discretization, data)
       , action(discretization, data)
       , active_set(parameters.solver, discretization, data, mpi_communicator)
@@ -248,20 +247,15 @@ namespace
                                            dof_handler,
                                            support_points);
 
-      scalar_dof_handler.distribute_dofs(discretization.fe->base_element(0));
-      discrete_problem.reinit(dof_handler,
-                              constraints,
-                              scalar_dof_handler,
-                              mpi_communicator);
+      discrete_problem.reinit(dof_handler, constraints, mpi_communicator);
       action.reinit(discrete_problem);
       active_set.reinit(discrete_problem);
-      solver.setup(discrete_problem,
-                   dof_handler,
-                   constraints,
-                   scalar_dof_handler);
+      solver.setup(discrete_problem, dof_handler, constraints);
 
-      solution.reinit(owned_dofs, mpi_communicator);
-      ghosted_solution.reinit(owned_dofs, relevant_dofs, mpi_communicator);
+      solution.reinit(std::vector<IndexSet>(2, owned_dofs), mpi_communicator);
+      ghosted_solution.reinit(std::vector<IndexSet>(2, owned_dofs),
+                              std::vector<IndexSet>(2, relevant_dofs),
+                              mpi_communicator);
       lambda_h.reinit(owned_dofs, relevant_dofs, mpi_communicator);
     }
 
@@ -269,7 +263,7 @@ namespace
     void
     solve()
     {
-      solver.solve(action, solution, active_set);
+      solver.solve(discrete_problem, dof_handler, action, solution, active_set);
       ghosted_solution = solution;
       lambda_h         = action.lambda_h(constraints);
     }
@@ -280,14 +274,14 @@ namespace
     {
       const auto &vertices = discrete_problem.vertices();
       for (unsigned int k = 0; k < vertices.size(); ++k)
-        if (support_points.at(vertices[k].dof[0]).distance(p) < 1e-12)
+        if (support_points.at(vertices[k].dof).distance(p) < 1e-12)
           return k;
       throw std::runtime_error("no vertex of V_h at the point");
     }
 
-    /** The u1 DoF of the (possibly hanging) vertex at @p p. */
+    /** The DoF of the (possibly hanging) vertex at @p p. */
     types::global_dof_index
-    u1_dof_at(const Point<dim> &p) const
+    dof_at(const Point<dim> &p) const
     {
       for (const auto &cell : dof_handler.active_cell_iterators())
         for (const unsigned int v : cell->vertex_indices())
@@ -296,7 +290,8 @@ namespace
       throw std::runtime_error("no vertex at the point");
     }
 
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
     const Parameters::All                         parameters;
     const MPI_Comm                                mpi_communicator;
@@ -306,7 +301,6 @@ namespace
     Discretization<dim>                           discretization;
     const std::unique_ptr<Triangulation<dim>>     triangulation;
     DoFHandler<dim>                               dof_handler;
-    DoFHandler<dim>                               scalar_dof_handler;
     IndexSet                                      owned_dofs, relevant_dofs;
     AffineConstraints<double>                     constraints;
     std::map<types::global_dof_index, Point<dim>> support_points;
@@ -315,7 +309,8 @@ namespace
     ActiveSet<dim>                                active_set;
     ActiveSetSolver<dim>                          solver;
     FluxReconstruction<dim>                       flux_reconstruction;
-    VectorType solution, ghosted_solution, lambda_h;
+    BlockVectorType                               solution, ghosted_solution;
+    VectorType                                    lambda_h;
   };
 
   /** The contact loads and the separating ones. */
@@ -339,8 +334,12 @@ namespace
     const auto &a      = problem.discrete_problem.vertices()[k];
     const auto &action = problem.action;
     // A wrong operator, load or solve (or boundary value) moves u_ih(a).
-    check(name + ": u1h at the vertex", problem.ghosted_solution[a.dof[0]], u);
-    check(name + ": u2h at the vertex", problem.ghosted_solution[a.dof[1]], u);
+    check(name + ": u1h at the vertex",
+          problem.ghosted_solution.block(0)[a.dof],
+          u);
+    check(name + ": u2h at the vertex",
+          problem.ghosted_solution.block(1)[a.dof],
+          u);
     // λ_a of membrane 1 by (4.5): a wrong d_a, sign or load term moves it.
     check(name + ": lambda_1a of (4.5)",
           action.lambda_from_membrane(0, k),
@@ -443,8 +442,12 @@ namespace
     // A vertex kept in contact where the membranes separate.
     check_true("Q1 2x2, apart: vertex a is inactive",
                !apart.active_set.is_active(ka));
-    check("Q1 2x2, apart: u1h(a)", apart.ghosted_solution[b.dof[0]], 3. / 16.);
-    check("Q1 2x2, apart: u2h(a)", apart.ghosted_solution[b.dof[1]], -3. / 64.);
+    check("Q1 2x2, apart: u1h(a)",
+          apart.ghosted_solution.block(0)[b.dof],
+          3. / 16.);
+    check("Q1 2x2, apart: u2h(a)",
+          apart.ghosted_solution.block(1)[b.dof],
+          -3. / 64.);
     // λ_a = 0 off contact, from both formulas (the scale: f1 = 2).
     check("Q1 2x2, apart: lambda_1a of (4.5)",
           apart.action.lambda_from_membrane(0, ka),
@@ -501,11 +504,11 @@ namespace
     check_contact_vertex(problem, ka, "Q1 hanging, vertex a", -1. / 32.);
     check_contact_vertex(problem, kb, "Q1 hanging, vertex b", -1. / 64.);
     // The hanging vertex c1 = (½,¼) follows its parents: u = ½ U_a.
-    const auto c1 = problem.u1_dof_at(Point<dim>(0.5, 0.25));
+    const auto c1 = problem.dof_at(Point<dim>(0.5, 0.25));
     check_true("Q1 hanging: c1 = (1/2,1/4) is constrained",
                problem.constraints.is_constrained(c1));
     check("Q1 hanging: u1h(c1) = u1h(a)/2",
-          problem.ghosted_solution[c1],
+          problem.ghosted_solution.block(0)[c1],
           -1. / 64.);
   }
 

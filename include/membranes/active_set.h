@@ -17,7 +17,7 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * A vertex whose status the active set method wants to change: its u1 DoF
+   * A vertex whose status the active set method wants to change: its DoF
    * and by how much its test is violated, in units of the band of
    * indifference (see ActiveSet), so at least 1.
    */
@@ -106,7 +106,7 @@ namespace membranes
 
     /**
      * The plain update: @p active_set with the status of the vertices
-     * @p dofs (locally owned u1 DoFs) changed.
+     * @p dofs (locally owned DoFs) changed.
      */
     static IndexSet
     toggled(const IndexSet                             &active_set,
@@ -169,9 +169,9 @@ namespace membranes
 
 
 
-  /** U_∞ = max|U| of @p solution (never zero: it divides). */
+  /** U_∞ = max|U| of @p solution, both blocks (never zero: it divides). */
   double
-  displacement_scale(const TrilinosWrappers::MPI::Vector &solution);
+  displacement_scale(const TrilinosWrappers::MPI::BlockVector &solution);
 
 
 
@@ -260,7 +260,7 @@ namespace membranes
    * cycle has been detected on the mesh, the plain update is used, so that the
    * remedy against cycling (ActiveSetHistory) works on the plain test.
    *
-   * Each process holds the locally owned vertices of A (u1 DoFs);
+   * Each process holds the locally owned vertices of A (their DoFs);
    * locally_relevant() tells every process the status of the vertices of
    * its ghost cells, for the constraints of the cells it assembles.
    */
@@ -268,8 +268,9 @@ namespace membranes
   class ActiveSet
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
-    using Vertex     = typename DiscreteProblem<dim>::Vertex;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
+    using Vertex          = typename DiscreteProblem<dim>::Vertex;
 
     ActiveSet(const Parameters::Solver  &parameters,
               const Discretization<dim> &discretization,
@@ -289,7 +290,7 @@ namespace membranes
      */
     void
     reinit(const DiscreteProblem<dim> &discrete_problem,
-           const VectorType           &solution,
+           const BlockVectorType      &solution,
            const VectorType           &ghosted_lambda_h);
 
     /** Whether the locally owned vertex k of DiscreteProblem::vertices() is
@@ -300,7 +301,7 @@ namespace membranes
       return active_flags[k];
     }
 
-    /** The locally owned active vertices (u1 DoFs). */
+    /** The locally owned active vertices (their DoFs). */
     const IndexSet &
     locally_owned() const;
 
@@ -319,25 +320,16 @@ namespace membranes
     locally_relevant() const;
 
     /**
-     * λ_a of @p lambda_h in the u1 slot and the active set indicator (1 or
-     * 0) in the u2 slot of every vertex of V_h, zero elsewhere (ghosted), as
-     * FieldOutput writes them.
-     */
-    VectorType
-    lambda_and_flags(const VectorType &lambda_h) const;
-
-    /**
      * W_a = u1h(a) − u2h(a) at the locally owned vertex k of
-     * DiscreteProblem::vertices(), read from the local storage of
-     * @p solution (a vector of the locally owned DoFs) at the positions of
-     * the vertex: no search per entry.
+     * DiscreteProblem::vertices(), read from the local storage of the two
+     * blocks of @p solution at the position of the vertex: no search per
+     * entry.
      */
     double
-    nodal_w(const unsigned int k, const VectorType &solution) const
+    nodal_w(const unsigned int k, const BlockVectorType &solution) const
     {
-      const double *const values   = solution.begin();
-      const auto         &position = problem->local_positions()[k];
-      return values[position[0]] - values[position[1]];
+      const unsigned int p = problem->local_positions()[k];
+      return solution.block(0).begin()[p] - solution.block(1).begin()[p];
     }
 
     /** c_a = μ̄ ∫|∇φ_a|² / d_a. */
@@ -350,7 +342,7 @@ namespace membranes
      */
     KKTDefects
     kkt_defects(const DiscreteAction<dim> &action,
-                const VectorType          &solution) const;
+                const BlockVectorType     &solution) const;
 
     /**
      * The locally owned vertices whose status the test wants to change on
@@ -359,7 +351,7 @@ namespace membranes
      */
     std::vector<StatusChange>
     wanted_changes(const DiscreteAction<dim> &action,
-                   const VectorType          &solution) const;
+                   const BlockVectorType     &solution) const;
 
     /** Start the record of the sets visited on this mesh (ActiveSetHistory). */
     void
@@ -384,7 +376,7 @@ namespace membranes
      * cycling, ActiveSetHistory::next().
      */
     Update
-    update(const VectorType                &solution,
+    update(const BlockVectorType           &solution,
            const std::vector<StatusChange> &changes);
 
   private:
@@ -404,7 +396,7 @@ namespace membranes
      * in `predicted_action`.
      */
     std::vector<StatusChange>
-    predicted_changes(const VectorType                &solution,
+    predicted_changes(const BlockVectorType           &solution,
                       const std::vector<StatusChange> &plain_changes);
 
     const Parameters::Solver &parameters;

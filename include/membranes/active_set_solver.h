@@ -4,7 +4,7 @@
 #include <array>
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/timer.h>
-#include <deal.II/lac/trilinos_vector.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <membranes/active_set.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discrete_problem.h>
@@ -157,7 +157,7 @@ namespace membranes
   class ActiveSetSolver
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType = TrilinosWrappers::MPI::BlockVector;
     using Statistics = ActiveSetStatistics;
 
     /**
@@ -175,28 +175,30 @@ namespace membranes
 
     /**
      * The linear systems for the mesh of @p discrete_problem, on
-     * @p dof_handler of (u1, u2) with @p hanging_node_constraints and on
-     * @p scalar_dof_handler.
+     * @p dof_handler with @p hanging_node_constraints.
      */
     void
     setup(const DiscreteProblem<dim>      &discrete_problem,
           const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints,
-          const DoFHandler<dim>           &scalar_dof_handler);
+          const AffineConstraints<double> &hanging_node_constraints);
 
     /**
-     * Run the active set method from the initial guess @p solution (locally
-     * owned entries) and the initial @p active_set. On return both hold the
+     * Run the active set method on the mesh of @p problem and
+     * @p dof_handler (those of the last setup()) from the initial guess
+     * @p solution (locally owned entries) and the initial @p active_set. On
+     * return both hold the
      * converged iterate, and @p action holds λ_a for it; if
      * ActiveSetNotConverged is thrown, the last iterate. @p expected_error
      * is the discretization error η̃ expected on this mesh for balanced
      * stopping, 0 if none is known.
      */
     Statistics
-    solve(DiscreteAction<dim> &action,
-          VectorType          &solution,
-          ActiveSet<dim>      &active_set,
-          const double         expected_error = 0);
+    solve(const DiscreteProblem<dim> &problem,
+          const DoFHandler<dim>      &dof_handler,
+          DiscreteAction<dim>        &action,
+          VectorType                 &solution,
+          ActiveSet<dim>             &active_set,
+          const double                expected_error = 0);
 
   private:
     /** Where the method stands in its stopping test on one mesh. */
@@ -325,8 +327,6 @@ namespace membranes
     const ConditionalOStream &pcout;
     TimerOutput              &timer;
     const MPI_Comm            mpi_communicator;
-
-    const DiscreteProblem<dim> *problem;
 
     /** The linear problem of one iteration, coupled or decoupled. */
     std::unique_ptr<ActiveSetSystem<dim>> system;

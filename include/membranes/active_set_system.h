@@ -4,6 +4,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/active_set_solver.h>
@@ -42,31 +43,34 @@ namespace membranes
   class ActiveSetSystem
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
     virtual ~ActiveSetSystem() = default;
 
     /**
      * Matrices, sparsity patterns and the constraints that do not depend on
-     * the active set, for the mesh of @p problem: @p dof_handler of (u1, u2)
-     * with its @p hanging_node_constraints, and @p scalar_dof_handler of
-     * its base element.
+     * the active set, for the mesh of @p problem: @p dof_handler with its
+     * @p hanging_node_constraints.
      */
     virtual void
     setup(const DiscreteProblem<dim>      &problem,
           const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints,
-          const DoFHandler<dim>           &scalar_dof_handler) = 0;
+          const AffineConstraints<double> &hanging_node_constraints) = 0;
 
     /**
-     * What the linear problem for @p active_set (u1 DoFs of the active
+     * What the linear problem on the mesh of @p problem and @p dof_handler
+     * for @p active_set (DoFs of the active
      * locally relevant vertices, ActiveSet::locally_relevant(), so that
      * every process knows the constraints of the cells it assembles) needs
      * before its solve; the constraints of this active set are set in
      * @p solution, the initial guess.
      */
     virtual void
-    assemble(const IndexSet &active_set, VectorType &solution) = 0;
+    assemble(const DiscreteProblem<dim> &problem,
+             const DoFHandler<dim>      &dof_handler,
+             const IndexSet             &active_set,
+             BlockVectorType            &solution) = 0;
 
     /**
      * Solve the linear problem of the last assemble(), starting from
@@ -74,9 +78,10 @@ namespace membranes
      * @p solution holds (u1h, u2h), constraints included.
      */
     virtual void
-    solve(VectorType             &solution,
-          const LinearTolerances &tolerances,
-          ActiveSetStatistics    &statistics) = 0;
+    solve(const DiscreteProblem<dim> &problem,
+          BlockVectorType            &solution,
+          const LinearTolerances     &tolerances,
+          ActiveSetStatistics        &statistics) = 0;
 
     /**
      * Free the matrices, vectors and the AMG hierarchy of this mesh once the
@@ -102,9 +107,6 @@ namespace membranes
     const ProblemData<dim>    &data;
     const MPI_Comm             mpi_communicator;
     LinearSolver<dim>          linear_solver;
-
-    /** The mesh: its index sets, operator and loads. */
-    const DiscreteProblem<dim> *problem;
 
   private:
     const std::string method;

@@ -15,26 +15,20 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * The contributions of one cell K to the reduced problem (3.4).
-   *
-   * First for the hat functions φ_v of the scalar element (P1 or Q1, the
-   * base element of the FESystem; v numbers the vertices of K):
+   * The contributions of one cell K to the reduced problem (3.4), for the
+   * hat functions φ_v of the scalar element (P1 or Q1; v numbers the
+   * vertices of K):
    *
    *   A_K(v, w)  = ∫_K ∇φ_v·∇φ_w   (the Laplacian),
    *   F_iK(v)    = ∫_K f_i φ_v      (the load of membrane i),
    *   m_K(v)     = ∫_K φ_v          (the lumped mass, whose sums are d_a).
    *
-   * Then, from these, for the shape functions φ_j of the FESystem
-   * (component c(j) = 0 for u1, 1 for u2, hat function v(j)):
-   *
-   *   matrix(j, k) = μ_c A_K(v(j), v(k))  if c(j) = c(k), 0 otherwise,
-   *   rhs(j)       = F_cK(v(j)),    lumped_mass(j) = m_K(v(j)).
-   *
-   * DiscreteProblem assembles the Laplacian and the loads of the mesh from
-   * the scalar parts, once per mesh, and keeps the loads F_iK of each cell;
-   * CoupledSystem assembles its system from the FESystem parts with those
-   * cell loads, and DecoupledSystem the matrix of w from A_K: all see the
-   * same bilinear form and the same quadrature of the loads.
+   * The membranes do not couple in (3.4): the cell matrix of membrane i is
+   * μ_i A_K. DiscreteProblem assembles the Laplacian and the loads of the
+   * mesh from these, once per mesh, and keeps the loads F_iK of each cell;
+   * CoupledSystem assembles its block system from A_K with those cell
+   * loads, and DecoupledSystem the matrix of w from A_K: all see the same
+   * bilinear form and the same quadrature of the loads.
    */
   template <int dim>
   class CellSystem
@@ -43,13 +37,12 @@ namespace membranes
     CellSystem(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /** Compute every matrix and vector below on @p cell, a cell of the
-     * DoFHandler of the FESystem. */
+    /** Compute every matrix and vector below on @p cell. */
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell);
 
     /**
-     * The same without the loads (`loads` and `rhs` are left as they are):
+     * The same without the loads (`loads` are left as they are):
      * what does not evaluate the data, for a right-hand side whose loads
      * were computed once per mesh.
      */
@@ -57,7 +50,7 @@ namespace membranes
     reinit_operator(const typename DoFHandler<dim>::active_cell_iterator &cell);
 
     /**
-     * Set `loads` and `rhs` from @p cell_loads: F_1K, then F_2K, as
+     * Set `loads` from @p cell_loads: F_1K, then F_2K, as
      * copy_loads() writes them.
      */
     void
@@ -74,9 +67,9 @@ namespace membranes
     void
     copy_loads(double *cell_loads) const;
 
-    /** A_K of the scalar element. */
+    /** A_K. */
     FullMatrix<double> laplace_matrix;
-    /** F_1K and F_2K of the scalar element. */
+    /** F_1K and F_2K. */
     std::array<Vector<double>, 2> loads;
     /**
      * The mean f̄_iK = ∫_K f_i / |K| and the oscillation ∫_K (f_i − f̄_iK)²
@@ -85,22 +78,15 @@ namespace membranes
      */
     std::array<double, 2> load_mean, load_oscillation;
 
-    FullMatrix<double>                   matrix;
-    Vector<double>                       rhs;
-    Vector<double>                       lumped_mass;
+    /** m_K. */
+    Vector<double> lumped_mass;
+    /** The DoFs of the vertices of K. */
     std::vector<types::global_dof_index> dof_indices;
-
-    /** The hat function v(j) of local shape function @p j of the FESystem. */
-    unsigned int
-    scalar_index_of(const unsigned int j) const;
 
   private:
     const ProblemData<dim>               &data;
     FEValues<dim>                         fe_values;
-    std::vector<unsigned int>             membrane;
-    std::vector<unsigned int>             scalar_index;
     typename ProblemData<dim>::LoadValues load_values;
-    Vector<double>                        scalar_lumped_mass;
   };
 } // namespace membranes
 

@@ -1,9 +1,9 @@
 #ifndef membranes_decoupled_system_h
 #define membranes_decoupled_system_h
 
-#include <deal.II/base/smartpointer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/diagonal_matrix.h>
 #include <membranes/active_set_system.h>
 #include <vector>
 
@@ -53,7 +53,7 @@ namespace membranes
    * solves A S = F_1 + F_2 from the initial guess. Every solve() then
    * imposes W_a = 0 on the active set and solves the obstacle problem's
    * linear system for W (inactive vertices: Λ_a = 0), and writes U1, U2
-   * into the solution of the two-component FESystem. ActiveSetSolver
+   * into the two blocks of the solution. ActiveSetSolver
    * computes λ_a by (4.5), and ActiveSet the next active set and the KKT
    * residual, from it exactly as for the coupled system: the test
    * Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of
@@ -64,12 +64,12 @@ namespace membranes
    * active vertices eliminated (the constraints W_a = 0 condensed). CG does
    * not need it as a matrix: it applies it as the operator
    * Π (μ̄ A) Π + (I − Π), Π the projection that sets the entries of the
-   * active vertices to zero (RestrictedOperator), with the matrix A of the
-   * mesh. The AMG hierarchy does need a matrix, and the right one: the
-   * hierarchy of A itself, seen through Π, took 2 to 3 times the CG
-   * iterations on case M (Q1, 5.3·10⁵ DoFs: 46 and 29 against 16 and 11
-   * per active set iteration), because the restriction of A⁻¹ to the
-   * inactive vertices is not the inverse of the restriction of A. So the
+   * active vertices to zero, a deal.II LinearOperator composed of the
+   * matrix A of the mesh and the diagonal matrices Π and I − Π. The AMG
+   * hierarchy does need a matrix, and the right one: the hierarchy of A
+   * itself, seen through Π, needs several times the CG iterations
+   * (benchmarks/README.md), because the restriction of A⁻¹ to the inactive
+   * vertices is not the inverse of the restriction of A. So the
    * first iteration of a mesh (and one whose CG iterations exceed twice
    * those of the one that built the hierarchy, plus rebuild_slack) condenses
    * the matrix of W by AffineConstraints in a cell loop, as step-41 does,
@@ -79,16 +79,18 @@ namespace membranes
    * iteration. One matrix per problem and mesh: A (for S, λ_h and the
    * operator of W) and the matrix of W.
    *
-   * Both scalar problems live on the scalar DoFHandler (the base element of
-   * the FESystem, on the same mesh and mapping), whose DoFs map one to one
-   * to the vertices. Each is half the size of the coupled system, and S is
+   * Both scalar problems live on the DoFHandler of the mesh, whose DoFs map
+   * one to one to the vertices: S, W and the blocks U1, U2 of the solution
+   * are vectors of the same layout, and each is a linear combination of the
+   * others. Each problem is half the size of the coupled system, and S is
    * solved only once.
    */
   template <int dim>
   class DecoupledSystem : public ActiveSetSystem<dim>
   {
   public:
-    using VectorType = typename ActiveSetSystem<dim>::VectorType;
+    using VectorType      = typename ActiveSetSystem<dim>::VectorType;
+    using BlockVectorType = typename ActiveSetSystem<dim>::BlockVectorType;
 
     DecoupledSystem(const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,
@@ -96,14 +98,13 @@ namespace membranes
                     const MPI_Comm             mpi_communicator);
 
     /**
-     * The constraints of S and of W on @p scalar_dof_handler, and the
-     * right-hand sides of both from the lifted loads of @p problem.
+     * The constraints of S and of W on @p dof_handler, and the right-hand
+     * sides of both from the lifted loads of @p problem.
      */
     void
     setup(const DiscreteProblem<dim>      &problem,
           const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints,
-          const DoFHandler<dim>           &scalar_dof_handler) override;
+          const AffineConstraints<double> &hanging_node_constraints) override;
 
     /**
      * S and W of @p solution on the first iteration of a mesh; the right-hand
@@ -111,16 +112,20 @@ namespace membranes
      * matrix of W when the solve needs it.
      */
     void
-    assemble(const IndexSet &active_set, VectorType &solution) override;
+    assemble(const DiscreteProblem<dim> &problem,
+             const DoFHandler<dim>      &dof_handler,
+             const IndexSet             &active_set,
+             BlockVectorType            &solution) override;
 
     /**
      * W, and (U1, U2) from S and W into @p solution. The first solve on a
      * mesh first solves for S (solve_s()).
      */
     void
-    solve(VectorType             &solution,
-          const LinearTolerances &tolerances,
-          ActiveSetStatistics    &statistics) override;
+    solve(const DiscreteProblem<dim> &problem,
+          BlockVectorType            &solution,
+          const LinearTolerances     &tolerances,
+          ActiveSetStatistics        &statistics) override;
 
     /** The constraints, vectors and the AMG hierarchy of this mesh. */
     void
@@ -132,18 +137,20 @@ namespace membranes
 
     /**
      * obstacle_matrix = μ̄ A with the constraints W_a = 0 of @p active_set
-     * (u1 DoFs of the locally relevant active vertices) condensed as
+     * (DoFs of the locally relevant active vertices) condensed as
      * AffineConstraints condenses them in a cell loop: their rows and
      * columns eliminated.
      */
     void
-    make_obstacle_matrix(const IndexSet &active_set);
+    make_obstacle_matrix(const DiscreteProblem<dim> &problem,
+                         const DoFHandler<dim>      &dof_handler,
+                         const IndexSet             &active_set);
 
     /** S of this mesh, from A S = F_1 + F_2, to the residual @p tolerance. */
     void
-    solve_s(const double tolerance, ActiveSetStatistics &statistics);
-
-    SmartPointer<const DoFHandler<dim>> dof_handler;
+    solve_s(const DiscreteProblem<dim> &problem,
+            const double                tolerance,
+            ActiveSetStatistics        &statistics);
 
     /** Hanging node constraints and the boundary values of S, of W. */
     AffineConstraints<double> s_constraints;
@@ -157,11 +164,11 @@ namespace membranes
     VectorType s;
     VectorType w;
     /**
-     * The positions of the locally owned active vertices in the scalar
-     * vectors, and the right-hand side of W, of the last assemble().
+     * Π and I − Π of the active set of the last assemble() (1 at the
+     * inactive, resp. active, vertices), and the right-hand side of W.
      */
-    std::vector<unsigned int> active_positions;
-    VectorType                rhs;
+    DiagonalMatrix<VectorType> inactive_projection, active_projection;
+    VectorType                 rhs;
     /** Whether S has been solved for on this mesh. */
     bool s_solved;
 

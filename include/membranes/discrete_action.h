@@ -5,6 +5,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discrete_problem.h>
 #include <membranes/discretization.h>
@@ -36,9 +37,10 @@ namespace membranes
    * λ_h is the function equal to λ_a on the dual cell D_a (a ∈ V_h); on the
    * pieces of a hanging vertex, the constraint-weighted mean of the λ_a of
    * its parents; zero on the pieces of boundary vertices, the strip ω \ ω_h.
-   * lambda_h() returns its nodal values as a vector, which the driver keeps
-   * and hands to the errors, both estimators, the flux reconstruction and
-   * the output; they read it through lambda_h_values() on the pieces of the
+   * lambda_h() returns its nodal values as one vector on the DoFs of the
+   * mesh, which the driver keeps and hands to the active set of the next
+   * mesh, the errors, both estimators, the flux reconstruction and the
+   * output; they read it through lambda_h_values() on the pieces of the
    * DualCellQuadrature, or its nodal interpolant through
    * nodal_lambda_values().
    *
@@ -48,7 +50,7 @@ namespace membranes
    * V_h, d_a, the operator and the loads are those of the DiscreteProblem of
    * the mesh, assembled once per mesh; this class only applies them to a
    * solution. Everything is stored for the locally owned vertices of V_h
-   * only, in the order of their u1 DoF index; the DoFs of the locally
+   * only, in the order of their DoF index; the DoFs of the locally
    * relevant vertices (those of the ghost cells too) are known for the
    * constraints and for λ_h on ghost cells.
    */
@@ -56,9 +58,10 @@ namespace membranes
   class DiscreteAction
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
-    /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
+    /** One vertex a of V_h: its DoF and the data of its dual cell. */
     using Vertex = typename DiscreteProblem<dim>::Vertex;
 
     DiscreteAction(const Discretization<dim> &discretization,
@@ -73,13 +76,14 @@ namespace membranes
     reinit(const DiscreteProblem<dim> &discrete_problem);
 
     /**
-     * Compute λ_a by (4.5) from both membranes for @p solution (locally
-     * owned entries, hanging nodes and boundary values set): one product
-     * of the operator of this mesh with @p solution, as step-41 obtains its
-     * contact forces from the residual of the assembled system.
+     * Compute λ_a by (4.5) from both membranes for @p solution (the blocks
+     * u1h, u2h, locally owned entries, hanging nodes and boundary values
+     * set): one product of the operator of this mesh with each block, as
+     * step-41 obtains its contact forces from the residual of the assembled
+     * system.
      */
     void
-    compute(const VectorType &solution);
+    compute(const BlockVectorType &solution);
 
     /** DiscreteProblem::load_mean_and_oscillation() of the mesh. */
     std::pair<double, double>
@@ -92,10 +96,9 @@ namespace membranes
     vertices() const;
 
     /**
-     * λ_h of the last compute(): a ghosted vector with the layout of the
-     * solution, λ_a in both DoF slots (u1 and u2) of every vertex a of V_h,
-     * at a hanging vertex the mean given by @p hanging_node_constraints,
-     * zero on ∂ω.
+     * λ_h of the last compute(): a ghosted vector on the DoFs of the mesh,
+     * λ_a at every vertex a of V_h, at a hanging vertex the mean given by
+     * @p hanging_node_constraints, zero on ∂ω.
      */
     VectorType
     lambda_h(const AffineConstraints<double> &hanging_node_constraints) const;
@@ -114,7 +117,7 @@ namespace membranes
                    const VectorType &lambda_h) const;
 
     /**
-     * λ_h on the pieces of the vertex whose u1 DoF is @p a (locally
+     * λ_h on the pieces of the vertex whose DoF is @p a (locally
      * relevant); zero if a is on ∂ω.
      */
     double
@@ -200,11 +203,8 @@ namespace membranes
     /** The mesh data of (4.5). */
     const DiscreteProblem<dim> *problem;
 
-    /**
-     * U_i, the nodal values of membrane i of the last solution, and the
-     * products A U_i (locally owned scalar DoFs).
-     */
-    std::array<VectorType, 2> membrane_values, stiffness_products;
+    /** The products A U_i of the last solution (locally owned DoFs). */
+    std::array<VectorType, 2> stiffness_products;
 
     /** λ_a from formula i of (4.5), by vertex, of the last compute(). */
     std::vector<std::array<double, 2>> membrane_lambdas;
@@ -217,8 +217,8 @@ namespace membranes
 
   /**
    * What a loop over cells reads on a cell at the points of the dual-cell
-   * quadrature: FEValues with @p update_flags, the nodal values of the
-   * solution (read into one buffer: the functions of FEValuesViews that take
+   * quadrature: FEValues with @p update_flags, the nodal values of each
+   * membrane (read into one buffer each: the functions of FEValues that take
    * the global vector allocate an aligned vector on every call, which on a
    * million cells fragments the heap), and λ_h with the points that lie in
    * ω_h. The error norms and the estimators hold one per thread.
@@ -234,23 +234,32 @@ namespace membranes
                   *discretization.fe,
                   action.dual_quadrature().quadrature(),
                   update_flags)
-      , local_dofs(discretization.fe->n_dofs_per_cell())
       , action(action)
       , nodal_lambda_h(lambda_h)
-    {}
+    {
+      for (auto &values : local_dofs)
+        values.resize(discretization.fe->n_dofs_per_cell());
+    }
 
-    /** Reinit on @p cell, with the nodal values of @p solution there. */
+    /**
+     * Reinit on @p cell, with the nodal values of the two blocks of
+     * @p solution there.
+     */
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell,
-           const TrilinosWrappers::MPI::Vector                  &solution)
+           const TrilinosWrappers::MPI::BlockVector             &solution)
     {
       fe_values.reinit(cell);
-      cell->get_dof_values(solution, local_dofs.begin(), local_dofs.end());
+      for (unsigned int i = 0; i < 2; ++i)
+        cell->get_dof_values(solution.block(i),
+                             local_dofs[i].begin(),
+                             local_dofs[i].end());
       action.lambda_h_values(cell, nodal_lambda_h, lambda_h, &in_omega_h);
     }
 
-    FEValues<dim>                        fe_values;
-    std::vector<double>                  local_dofs;
+    FEValues<dim> fe_values;
+    /** The nodal values of u_ih on the cell, i = 0, 1. */
+    std::array<std::vector<double>, 2>   local_dofs;
     std::vector<double>                  lambda_h;
     std::vector<bool>                    in_omega_h;
     const DiscreteAction<dim>           &action;

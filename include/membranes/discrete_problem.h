@@ -44,14 +44,14 @@ namespace membranes
    * reference, by everything that works on the mesh: DiscreteAction (the
    * postprocessing (4.5)), the linear systems of the active set method
    * (CoupledSystem, DecoupledSystem) and the ActiveSet. It holds no
-   * reference to the DoFHandlers it was built on; what needs one gets it
+   * reference to the DoFHandler it was built on; what needs one gets it
    * from its owner, MembraneProblem.
    *
    * Both membranes live on one mesh with the same scalar element, so their
    * Laplacians are one matrix A and the operator of membrane i is μ_i A.
-   * The DoFs of (u1, u2) in the FESystem are numbered vertex by vertex
-   * (those of scalar DoF k are 2k and 2k + 1), which reinit() checks; a
-   * vector of the FESystem and two scalar vectors hold the same numbers.
+   * One DoFHandler of the scalar element numbers the vertices; membrane i
+   * is block i of the vectors of the mesh (Discretization), so a vertex has
+   * one DoF, the same in both blocks.
    *
    * It holds
    * - A = (∫ ∇φ_a·∇φ_b), condensed by AffineConstraints with the hanging
@@ -79,11 +79,11 @@ namespace membranes
   public:
     using VectorType = TrilinosWrappers::MPI::Vector;
 
-    /** One vertex a of V_h: its two DoFs and the data of its dual cell. */
+    /** One vertex a of V_h: its DoF and the data of its dual cell. */
     struct Vertex
     {
-      /** DoF of u1 (index 0) and of u2 (index 1) at a. */
-      std::array<types::global_dof_index, 2> dof;
+      /** The DoF of a, the same in both blocks (u1h(a), u2h(a)). */
+      types::global_dof_index dof;
       /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
       double dual_cell_measure;
       /**
@@ -104,40 +104,37 @@ namespace membranes
                     const ProblemData<dim>    &data);
 
     /**
-     * Assemble A, the loads and d_a on the mesh of @p dof_handler (the
-     * FESystem of (u1, u2), with its hanging node constraints
-     * @p hanging_node_constraints) and @p scalar_dof_handler (its base
-     * element on the same mesh), and find V_h.
+     * Assemble A, the loads and d_a on the mesh of @p dof_handler, with its
+     * hanging node constraints @p hanging_node_constraints, and find V_h.
      */
     void
     reinit(const DoFHandler<dim>           &dof_handler,
            const AffineConstraints<double> &hanging_node_constraints,
-           const DoFHandler<dim>           &scalar_dof_handler,
            const MPI_Comm                   mpi_communicator);
 
     /**
-     * The hanging node constraints of @p scalar_dof_handler and the boundary
-     * values c1 g + c2 g2 on all of ∂ω, into @p constraints (closed): those
-     * of u1 (1, 0), u2 (0, 1) and of their combinations s and w.
+     * @p hanging_node_constraints of @p dof_handler and the boundary values
+     * c1 g + c2 g2 on all of ∂ω, into @p constraints (closed): those of u1
+     * (1, 0), u2 (0, 1) and of their combinations s and w.
      */
     void
-    make_constraints(const DoFHandler<dim>     &scalar_dof_handler,
-                     const double               c1,
-                     const double               c2,
-                     AffineConstraints<double> &constraints) const;
+    make_constraints(const DoFHandler<dim>           &dof_handler,
+                     const AffineConstraints<double> &hanging_node_constraints,
+                     const double                     c1,
+                     const double                     c2,
+                     AffineConstraints<double>       &constraints) const;
 
     MPI_Comm
     get_mpi_communicator() const;
-    /** Index sets of the FESystem of (u1, u2). */
+    /**
+     * The index sets of the step-40 layout: the locally owned DoFs of the
+     * mesh, and those of the owned and ghost cells. Every block of a vector
+     * of the mesh has them.
+     */
     const IndexSet &
     locally_owned_dofs() const;
     const IndexSet &
     locally_relevant_dofs() const;
-    /** Index sets of the scalar element. */
-    const IndexSet &
-    locally_owned_scalar_dofs() const;
-    const IndexSet &
-    locally_relevant_scalar_dofs() const;
 
     /** A, condensed with the hanging node constraints and boundary values. */
     const TrilinosWrappers::SparseMatrix &
@@ -165,29 +162,27 @@ namespace membranes
       const typename DoFHandler<dim>::active_cell_iterator &cell,
       const unsigned int                                    i) const;
 
-    /** The locally owned vertices of V_h, by increasing u1 DoF. */
+    /** The locally owned vertices of V_h, by increasing DoF. */
     const std::vector<Vertex> &
     vertices() const;
 
     /**
-     * The positions of the DoFs (u1, u2) of vertices() in the local storage
-     * of a vector of the locally owned DoFs of the FESystem (all such
-     * vectors share one layout): reading them there needs no search per
-     * entry. Half the position of the u1 DoF is that of the vertex in a
-     * scalar vector.
+     * The positions of the DoFs of vertices() in the local storage of a
+     * vector of the locally owned DoFs (every block of a vector of the mesh
+     * has that layout): reading them there needs no search per entry.
      */
-    const std::vector<std::array<int, 2>> &
+    const std::vector<unsigned int> &
     local_positions() const;
 
     /**
-     * The DoFs (u1, u2) of the locally relevant vertices of V_h: those of
-     * the locally owned and ghost cells.
+     * The DoFs of the locally relevant vertices of V_h: those of the
+     * locally owned and ghost cells.
      */
-    const std::vector<std::array<types::global_dof_index, 2>> &
+    const std::vector<types::global_dof_index> &
     locally_relevant_vertices() const;
 
     /**
-     * Whether the u1 DoF @p a (locally relevant) belongs to an interior
+     * Whether the DoF @p a (locally relevant) belongs to an interior
      * vertex, of V_h or hanging: the vertices whose dual cells make up ω_h.
      */
     bool
@@ -211,9 +206,12 @@ namespace membranes
      * condensed by distribute_local_to_global with its constraints.
      */
     void
-    assemble(const DoFHandler<dim> &dof_handler,
-             VectorType            &dual_cell_measure,
-             VectorType            &stiffness_diagonal);
+    assemble(
+      const DoFHandler<dim>                          &dof_handler,
+      const AffineConstraints<double>                &hanging_node_constraints,
+      const std::array<AffineConstraints<double>, 2> &membrane_constraints,
+      VectorType                                     &dual_cell_measure,
+      VectorType                                     &stiffness_diagonal);
 
     /** V_h and its data, from the vectors that assemble() fills. */
     void
@@ -227,12 +225,6 @@ namespace membranes
 
     MPI_Comm mpi_communicator;
     IndexSet owned_dofs, relevant_dofs;
-    IndexSet owned_scalar_dofs, relevant_scalar_dofs;
-
-    /** Hanging nodes and boundary values g_i of membrane i. */
-    std::array<AffineConstraints<double>, 2> membrane_constraints;
-    /** The hanging node constraints of the scalar element. */
-    AffineConstraints<double> scalar_hanging_node_constraints;
 
     TrilinosWrappers::SparseMatrix matrix;
     std::array<VectorType, 2>      load_vectors;
@@ -245,10 +237,10 @@ namespace membranes
     std::vector<double> loads_of_cells;
     unsigned int        loads_per_cell;
 
-    std::vector<Vertex>                                 interior_vertices;
-    std::vector<std::array<int, 2>>                     positions;
-    std::vector<std::array<types::global_dof_index, 2>> relevant_vertices;
-    IndexSet                                            interior_vertex_dofs;
+    std::vector<Vertex>                  interior_vertices;
+    std::vector<unsigned int>            positions;
+    std::vector<types::global_dof_index> relevant_vertices;
+    IndexSet                             interior_vertex_dofs;
     /** is_interior_vertex() by the index of the vertex in the mesh. */
     std::vector<char> interior_vertex_flags;
   };

@@ -3,7 +3,7 @@
 
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature.h>
-#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/grid/tria.h>
 #include <membranes/parameters.h>
@@ -19,12 +19,13 @@ namespace membranes
    * triangles (FE_SimplexP, MappingFE, QGaussSimplex) or Q1 on
    * quadrilaterals (FE_Q, MappingQ1, QGauss).
    *
-   * Both membranes live in one FESystem with two components (u1, u2) on one
-   * DoFHandler. This is what makes the contact constraint u1(a) = u2(a) on
-   * active vertices an ordinary AffineConstraints line between two DoFs of
-   * the same handler, to be merged with hanging-node and boundary
-   * constraints, and gives one sparsity pattern, one matrix and one
-   * SolutionTransfer for the pair.
+   * Both membranes live in the same scalar space: one DoFHandler of this
+   * element numbers the vertices of the mesh, and the two membranes are the
+   * two blocks of its vectors (u1h = solution.block(0), u2h =
+   * solution.block(1)), the way deal.II's step-22 holds velocity and
+   * pressure. s = μ1 u1 + μ2 u2 and w = u1 − u2 are vector operations on
+   * the blocks, and the stiffness matrix of the mesh is one matrix A of the
+   * scalar element, μ_i A for membrane i.
    *
    * On a mesh of axis-parallel rectangles (the square, the L-shape and the
    * slit, and every refinement of them) the mapping of each cell is a
@@ -49,9 +50,9 @@ namespace membranes
     void
     select_mapping(const Triangulation<dim> &triangulation);
 
-    const Parameters::CellType           cell_type;
-    const std::unique_ptr<FESystem<dim>> fe;
-    std::unique_ptr<Mapping<dim>>        mapping;
+    const Parameters::CellType                cell_type;
+    const std::unique_ptr<FiniteElement<dim>> fe;
+    std::unique_ptr<Mapping<dim>>             mapping;
 
     /** Whether select_mapping() found a mesh of axis-parallel rectangles
      * (and took MappingCartesian), on which a Q1 function has

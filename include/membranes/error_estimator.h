@@ -5,6 +5,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
 #include <membranes/discrete_action.h>
@@ -113,7 +114,8 @@ namespace membranes
   class ErrorEstimator
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
     /**
      * The flux estimator η and its parts, over all processes: η² =
@@ -143,12 +145,13 @@ namespace membranes
     /**
      * The residual estimator: fill @p indicators (indexed by
      * active_cell_index(), zero on cells not locally owned) with its η_K²
-     * and return η over all processes, with @p lambda_h the λ_h of
-     * @p action (DiscreteAction::lambda_h()).
+     * and return η over all processes, with @p ghosted_solution the blocks
+     * u1h, u2h (ghosted) and @p lambda_h the λ_h of @p action
+     * (DiscreteAction::lambda_h()).
      */
     double
     residual_estimate(const DoFHandler<dim>     &dof_handler,
-                      const VectorType          &ghosted_solution,
+                      const BlockVectorType     &ghosted_solution,
                       const DiscreteAction<dim> &action,
                       const VectorType          &lambda_h,
                       Vector<double>            &indicators,
@@ -160,7 +163,7 @@ namespace membranes
      */
     FluxEstimate
     flux_estimate(const DoFHandler<dim>        &dof_handler,
-                  const VectorType             &ghosted_solution,
+                  const BlockVectorType        &ghosted_solution,
                   const DiscreteAction<dim>    &action,
                   const VectorType             &lambda_h,
                   const FluxEquilibration<dim> &flux_equilibration,
@@ -173,7 +176,7 @@ namespace membranes
     /** Element residuals, oscillation and the contact term. */
     void
     add_cell_terms(const DoFHandler<dim>     &dof_handler,
-                   const VectorType          &ghosted_solution,
+                   const BlockVectorType     &ghosted_solution,
                    const DiscreteAction<dim> &action,
                    const VectorType          &lambda_h,
                    Vector<double>            &indicators) const;
@@ -181,13 +184,13 @@ namespace membranes
     /** The boundary data part of FluxEstimate. */
     double
     boundary_data_part(const DoFHandler<dim> &dof_handler,
-                       const VectorType      &ghosted_solution,
+                       const BlockVectorType &ghosted_solution,
                        const MPI_Comm         mpi_communicator) const;
 
     /** ½ h_e μ_i⁻¹ ‖[μ_i ∂_n u_ih]‖²_e on both cells of every interior edge. */
     void
     add_jump_terms(const DoFHandler<dim> &dof_handler,
-                   const VectorType      &ghosted_solution,
+                   const BlockVectorType &ghosted_solution,
                    Vector<double>        &indicators) const;
 
     /** The traces on an edge between quadrilaterals (defined in the .cc). */
@@ -199,7 +202,7 @@ namespace membranes
      */
     std::vector<std::array<Tensor<1, dim>, 2>>
     p1_gradients(const DoFHandler<dim> &dof_handler,
-                 const VectorType      &ghosted_solution) const;
+                 const BlockVectorType &ghosted_solution) const;
 
     /**
      * ∫_e |[μ_i ∂_n u_ih]|² (i = 1, 2) on the edge @p f of @p cell between
@@ -216,10 +219,10 @@ namespace membranes
      * derivative of Q1 varies along the edge).
      */
     std::array<double, 2>
-    q1_jump_integrals(const CellIterator &cell,
-                      const unsigned int  f,
-                      const VectorType   &ghosted_solution,
-                      JumpScratch        &scratch) const;
+    q1_jump_integrals(const CellIterator    &cell,
+                      const unsigned int     f,
+                      const BlockVectorType &ghosted_solution,
+                      JumpScratch           &scratch) const;
 
     /**
      * The terms of the flux estimator, on one cell K or summed over cells:
@@ -245,7 +248,7 @@ namespace membranes
     /** The FluxTerms of one locally owned cell. */
     FluxTerms
     flux_terms(const CellIterator           &cell,
-               const VectorType             &ghosted_solution,
+               const BlockVectorType        &ghosted_solution,
                const DiscreteAction<dim>    &action,
                const FluxEquilibration<dim> &flux_equilibration,
                FluxScratch                  &scratch) const;

@@ -4,6 +4,7 @@
 #include <array>
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discrete_action.h>
 #include <membranes/discretization.h>
@@ -39,7 +40,8 @@ namespace membranes
   class ErrorNorms
   {
   public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
     struct Errors
     {
@@ -52,10 +54,13 @@ namespace membranes
     ErrorNorms(const Discretization<dim> &discretization,
                const ProblemData<dim>    &data);
 
-    /** With @p lambda_h the λ_h of @p action (DiscreteAction::lambda_h()). */
+    /**
+     * The errors of @p ghosted_solution (the blocks u1h, u2h, ghosted), with
+     * @p lambda_h the λ_h of @p action (DiscreteAction::lambda_h()).
+     */
     Errors
     compute(const DoFHandler<dim>     &dof_handler,
-            const VectorType          &ghosted_solution,
+            const BlockVectorType     &ghosted_solution,
             const DiscreteAction<dim> &action,
             const VectorType          &lambda_h,
             const MPI_Comm             mpi_communicator) const;

@@ -124,6 +124,9 @@ namespace membranes
      * comment), each solved by the owner of a on the records of its cells,
      * with @p patch_terms from FluxReconstruction::reconstruct() and the
      * λ_a of @p lambda_h (DiscreteAction::lambda_h()); then the rotations.
+     * @p hanging_node_constraints and @p locally_owned_dofs are those of the
+     * DoFHandler of the reconstruction (one DoF per vertex), by which the
+     * vertices a and their owners are found.
      */
     void
     equilibrate(const AlignedVector<PatchTerms> &patch_terms,

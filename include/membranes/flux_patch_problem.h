@@ -25,7 +25,10 @@ namespace membranes
    */
   struct PatchRecord
   {
-    /** The global DoF index (of u_1h) of the vertex a of the patch. */
+    /**
+     * The global DoF index of the vertex a of the patch (the same in both
+     * blocks).
+     */
     types::global_dof_index vertex;
     /**
      * The key of the unknown flux through edge 2 of κ: the global DoF

@@ -11,6 +11,7 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/grid/reference_cell.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <map>
 #include <membranes/discrete_action.h>
@@ -103,8 +104,9 @@ namespace membranes
   class FluxReconstruction
   {
   public:
-    using VectorType   = TrilinosWrappers::MPI::Vector;
-    using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
+    using CellIterator    = typename DoFHandler<dim>::active_cell_iterator;
 
     /** The defects of the identities of §4.3, relative to the data. */
     struct Identities
@@ -134,12 +136,12 @@ namespace membranes
                        const DiscreteAction<dim> &action);
 
     /**
-     * An edge or a half-edge of the mesh, by the global DoF indices (of
-     * u_1h) of its end vertices, which are exact and the same on every
-     * process: an edge by its two ends in increasing order, the half-edge
-     * a–m_e of the edge (a, b) by (a, b). (Two vertices end at most one
-     * edge, and an edge is named either whole or by its two halves, so
-     * names never meet.)
+     * An edge or a half-edge of the mesh, by the global DoF indices of its
+     * end vertices (one per vertex, the same in both blocks), which are
+     * exact and the same on every process: an edge by its two ends in
+     * increasing order, the half-edge a–m_e of the edge (a, b) by (a, b). (Two
+     * vertices end at most one edge, and an edge is named either whole or by
+     * its two halves, so names never meet.)
      */
     using EdgeKey = std::array<types::global_dof_index, 2>;
 
@@ -198,20 +200,23 @@ namespace membranes
     };
 
     /**
-     * Compute t_1h, t_2h for @p ghosted_solution on the locally owned
-     * cells of @p dof_handler (and what they need of the ghost cells).
+     * Compute t_1h, t_2h for @p ghosted_solution (the blocks u1h, u2h on
+     * the DoFs of @p dof_handler, ghosted) on the locally owned cells of
+     * @p dof_handler (and what they need of the ghost cells).
      * Returns the PatchTerms of the sub-triangles of the owned cells, by
      * active cell index × sub-triangles per cell + sub-triangle, for
      * FluxEquilibration::equilibrate().
      */
     AlignedVector<PatchTerms>
     reconstruct(const DoFHandler<dim> &dof_handler,
-                const VectorType      &ghosted_solution);
+                const BlockVectorType &ghosted_solution);
 
     /**
      * The defects of the identities for the t_ih of the last reconstruct(),
-     * against the λ_a of the action. Only the output asks for them: the
-     * flux estimator does not need them.
+     * against the λ_a of the action, with the hanging node constraints
+     * @p hanging_node_constraints and the locally owned DoFs
+     * @p locally_owned_dofs of the DoFHandler of reconstruct(). Only the
+     * output asks for them: the flux estimator does not need them.
      */
     Identities
     identities(const AffineConstraints<double> &hanging_node_constraints,
@@ -271,13 +276,13 @@ namespace membranes
      * the minimization of the half-edge fluxes are returned.
      */
     HalfEdgeMinimization
-    compute_local_fluxes(const VectorType          &ghosted_solution,
+    compute_local_fluxes(const BlockVectorType     &ghosted_solution,
                          AlignedVector<PatchTerms> &patch_terms);
 
     /** The worker of compute_local_fluxes() on @p cell. */
     void
     local_fluxes_on_cell(const CellIterator        &cell,
-                         const VectorType          &ghosted_solution,
+                         const BlockVectorType     &ghosted_solution,
                          AlignedVector<PatchTerms> &patch_terms,
                          LocalFluxScratch          &scratch,
                          LocalFluxCopy             &copy);
@@ -332,12 +337,13 @@ namespace membranes
 
     /**
      * Per vertex a, condensed with the hanging node constraints: meas(D_a),
-     * ∫_{D_a} div t_ih, f_ih meas(D_a) and f_ih ∫ φ_a (per i at the DoF of
-     * membrane i).
+     * and in block i for membrane i ∫_{D_a} div t_ih, f_ih meas(D_a) and
+     * f_ih ∫ φ_a.
      */
     struct DualCellSums
     {
-      VectorType measure, divergence, load_on_pieces, load_on_hats;
+      VectorType      measure;
+      BlockVectorType divergence, load_on_pieces, load_on_hats;
     };
 
     /** The DualCellSums of the locally owned cells. */

@@ -90,7 +90,11 @@ namespace membranes
   class SubTriangleBasis
   {
   public:
-    /** The basis on the sub-triangles of @p dual for the element @p fe. */
+    /**
+     * The basis on the sub-triangles of @p dual for the scalar P1/Q1
+     * element @p fe (Discretization::fe), whose shape function v is the hat
+     * function of vertex v.
+     */
     SubTriangleBasis(const DualCellQuadrature<dim> &dual,
                      const FiniteElement<dim>      &fe);
 

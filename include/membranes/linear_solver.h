@@ -35,9 +35,9 @@ namespace membranes
    * meshes), and starts from the vector it is given (the previous active set
    * iterate, or the interpolated solution of the previous mesh), so later
    * iterations of the active set method are cheap. It runs on any operator
-   * with a vmult(): a matrix, or the matrix seen through RestrictedOperator
-   * or ScaledOperator, with the AMG hierarchy of initialize_preconditioner()
-   * seen the same way.
+   * with a vmult(): a matrix, or a LinearOperator composed from it (the
+   * projection of DecoupledSystem, the scaling of CoupledSystem), with the
+   * AMG hierarchy of initialize_preconditioner() composed the same way.
    */
   template <int dim>
   class LinearSolver
@@ -60,9 +60,14 @@ namespace membranes
     LinearSolver(const Parameters::LinearSolverType type,
                  const MPI_Comm                     mpi_communicator);
 
-    /** Choose the method for the current problem size; forget the AMG. */
+    /**
+     * Choose the method for a problem of @p n_unknowns unknowns; forget the
+     * AMG. @p constant_modes (by locally owned unknown, one vector per
+     * mode) are the near null space that the AMG hierarchy is built for.
+     */
     void
-    reinit(const DoFHandler<dim> &dof_handler);
+    reinit(const types::global_dof_index         n_unknowns,
+           const std::vector<std::vector<bool>> &constant_modes);
 
     /** Whether reinit() chose the direct solver. */
     bool
@@ -135,87 +140,6 @@ namespace membranes
 
 
 
-  /**
-   * The operator Π (c B) Π + (I − Π) of an operator B (a matrix, or its AMG
-   * hierarchy), where Π sets the entries at a set of locally owned
-   * positions to zero: B restricted to the other entries, the identity on
-   * these. With B = A and the positions of the active vertices it is the
-   * matrix of the obstacle problem of one active set iteration with its
-   * constraints W_a = 0 condensed (DecoupledSystem), applied without a
-   * matrix of its own; with B the AMG hierarchy of A and c = 1/μ̄ it is its
-   * preconditioner. A vector with zeros at the positions is mapped to one
-   * with zeros there, so CG started there stays there.
-   */
-  template <typename OperatorType>
-  class RestrictedOperator
-  {
-  public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
-
-    RestrictedOperator(const OperatorType              &op,
-                       const double                     coefficient,
-                       const std::vector<unsigned int> &positions,
-                       const VectorType                &layout)
-      : op(op)
-      , coefficient(coefficient)
-      , positions(positions)
-      , restricted(layout)
-    {}
-
-    void
-    vmult(VectorType &dst, const VectorType &src) const
-    {
-      restricted = src;
-      for (const unsigned int p : positions)
-        restricted.begin()[p] = 0;
-      op.vmult(dst, restricted);
-      dst *= coefficient;
-      for (const unsigned int p : positions)
-        dst.begin()[p] = src.begin()[p];
-    }
-
-  private:
-    const OperatorType              &op;
-    const double                     coefficient;
-    const std::vector<unsigned int> &positions;
-    mutable VectorType               restricted;
-  };
-
-
-
-  /**
-   * The operator D B D of an operator B and a diagonal D (a vector of the
-   * locally owned entries): the symmetric scaling of a system K x = b to
-   * D K D y = D b, x = D y, whose residual D(b − K x) is the one measured
-   * (CoupledSystem); with B the AMG hierarchy of K and D⁻¹ it is the
-   * preconditioner of the scaled system.
-   */
-  template <typename OperatorType>
-  class ScaledOperator
-  {
-  public:
-    using VectorType = TrilinosWrappers::MPI::Vector;
-
-    ScaledOperator(const OperatorType &op, const VectorType &scaling)
-      : op(op)
-      , scaling(scaling)
-      , scaled(scaling)
-    {}
-
-    void
-    vmult(VectorType &dst, const VectorType &src) const
-    {
-      scaled = src;
-      scaled.scale(scaling);
-      op.vmult(dst, scaled);
-      dst.scale(scaling);
-    }
-
-  private:
-    const OperatorType &op;
-    const VectorType   &scaling;
-    mutable VectorType  scaled;
-  };
 } // namespace membranes
 
 #endif

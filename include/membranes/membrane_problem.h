@@ -7,6 +7,7 @@
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/numerics/solution_transfer.h>
 #include <membranes/active_set.h>
@@ -74,7 +75,8 @@ namespace membranes
     run();
 
   private:
-    using VectorType = TrilinosWrappers::MPI::Vector;
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
     void
     make_grid();
@@ -123,20 +125,23 @@ namespace membranes
     Discretization<dim> discretization;
 
     const std::unique_ptr<Triangulation<dim>> triangulation;
-    /** (u1, u2) on the FESystem, and the scalar element of each. */
+    /** The DoFs of the scalar P1/Q1 element: one per vertex. */
     DoFHandler<dim>           dof_handler;
-    DoFHandler<dim>           scalar_dof_handler;
-    IndexSet                  locally_owned_dofs;
-    IndexSet                  locally_relevant_dofs;
     AffineConstraints<double> hanging_node_constraints;
-
-    /** (u1h, u2h): locally owned entries, and a ghosted copy for reading. */
-    VectorType solution;
-    VectorType ghosted_solution;
-    /** λ_a in both DoF slots of every vertex a of V_h (ghosted). */
-    VectorType lambda_h;
-    /** Laplacian, loads, d_a and V_h of the current mesh. */
+    /**
+     * Laplacian, loads, d_a and V_h of the current mesh, and its index sets
+     * (locally owned and relevant DoFs).
+     */
     DiscreteProblem<dim> discrete_problem;
+
+    /**
+     * (u1h, u2h) as the blocks 0 and 1: locally owned entries, and a ghosted
+     * copy for reading.
+     */
+    BlockVectorType solution;
+    BlockVectorType ghosted_solution;
+    /** λ_a at every vertex a of V_h (ghosted; DiscreteAction::lambda_h()). */
+    VectorType lambda_h;
     /** The active vertices. */
     ActiveSet<dim> active_set;
     /** η_K² of the estimator that drives refinement, by active cell index. */
@@ -153,7 +158,7 @@ namespace membranes
     OutputDirectory output_directory;
 
     /**
-     * Carries (u_h, λ_h) from one mesh to the next: the distributed
+     * Carries (u1h, u2h, λ_h) from one mesh to the next: the distributed
      * SolutionTransfer on p4est meshes, with the ghosted vectors; the serial
      * one on triangles, whose mesh every process holds whole, with copies
      * of the vectors that hold every entry.

@@ -84,9 +84,8 @@ namespace membranes
     load_list(const std::vector<Point<dim>> &points, LoadValues &values) const;
 
     /**
-     * The boundary values as one function with two components (g, g2), as
-     * VectorTools::interpolate_boundary_values wants them for the FESystem
-     * that holds (u1, u2).
+     * The boundary values as one function with two components (g, g2):
+     * component i is the boundary value of membrane i.
      */
     const Function<dim> &
     boundary_values() const;
