@@ -257,8 +257,8 @@ namespace membranes
         // for both DoFs of an active vertex: D K D y = D b, u = D y. Its
         // residual D r then has the norm Σ_a (r_W,a² / μ̄ + r_S,a² /
         // (μ1 + μ2)) (sums over active vertices only r_S), so one bound on
-        // it bounds r_S and r_W each on its own scale. The AMG hierarchy of
-        // K, seen through D⁻¹, preconditions it.
+        // it bounds r_S and r_W each on its own scale. D⁻¹ P D⁻¹, P the AMG
+        // hierarchy of K built on every iteration, preconditions it.
         VectorType inverse_scaling(scaling);
         for (auto &entry : inverse_scaling)
           entry = 1 / entry;

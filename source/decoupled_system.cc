@@ -194,8 +194,9 @@ namespace membranes
       this->linear_solver.solve_direct(obstacle_matrix, w, rhs);
     else
       {
-        // CG on Π μ̄A Π + (I − Π), preconditioned by the hierarchy of the
-        // matrix of W of the iteration that built it, restricted alike.
+        // CG on Π μ̄A Π + (I − Π), preconditioned by Π P Π + (I − Π), P the
+        // hierarchy of the matrix of W (μ̄ included) of the iteration that
+        // built it.
         const bool builds_hierarchy = !this->linear_solver.has_preconditioner();
         if (builds_hierarchy)
           this->linear_solver.initialize_preconditioner(obstacle_matrix);

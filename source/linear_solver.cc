@@ -47,14 +47,8 @@ namespace membranes
   void
   LinearSolver<dim>::initialize_preconditioner(const MatrixType &matrix)
   {
-    // Smoothed aggregation, the default of ML. Its setup (the smoothed
-    // prolongator, ML_2matmult) sets the peak memory of a run; other
-    // settings measured on case M, Q1, 2.1·10⁶ DoFs (solver_cost.sh, medians
-    // of 3): unsmoothed aggregation (damping factor 0) 764 against 858
-    // B/DoF at 3 times the CG iterations (+39 % solve time even with a
-    // W-cycle), tentative restriction 819 B/DoF at +26 % solve time;
-    // uncoupled or MIS aggregation, "low memory usage", more smoother
-    // sweeps gain nothing. The process holds 697 B/DoF before ML starts.
+    // Smoothed aggregation (ML's default): lower-memory settings slow CG down
+    // (benchmarks/README.md, "The settings of ML and the peak memory").
     TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
     amg_data.elliptic        = true;
     amg_data.constant_modes  = constant_modes;

@@ -312,10 +312,10 @@ namespace membranes::Parameters
                       selection(methods),
                       "coupled: active set method on (u1, u2); decoupled: "
                       "linear problem for s = mu1 u1 + mu2 u2 and obstacle "
-                      "problem for w = u1 - u2; auto: the faster of the two "
-                      "for the scene (decoupled, half the size, for constant "
-                      "tensions); coupled and decoupled give the same "
-                      "discrete solution.");
+                      "problem for w = u1 - u2; auto: always decoupled (half "
+                      "the size, s solved once per mesh, its operators from "
+                      "the matrix of the mesh); coupled and decoupled give "
+                      "the same discrete solution.");
     prm.declare_entry(
       "Linear solver",
       "auto",

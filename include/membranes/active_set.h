@@ -178,8 +178,8 @@ namespace membranes
   /**
    * The active set of the primal-dual active set method (ActiveSetSolver):
    * the set A ⊂ V_h of the vertices where the membranes are in contact, its
-   * initial value on a new mesh, its update from an iterate, and the
-   * constraint lines it imposes.
+   * initial value on a new mesh and its update from an iterate. The linear
+   * systems impose it (ActiveSetSystem::assemble()).
    *
    * With W_a = u1h(a) − u2h(a) (ActiveSet::nodal_w()) and the nodal multiplier
    * Λ_a = λ_a of (4.5), the active set is
@@ -222,18 +222,16 @@ namespace membranes
    * a finer mesh reaches several layers of vertices beyond the one
    * interpolated from the coarser mesh: with u1 − u2 ~ dist³, the O(h²)
    * errors of the coarse solution move its edge by O(h^{2/3}), i.e. by
-   * O(h^{−1/3}) layers (measured: the contact radius 0.4774, 0.4853,
-   * 0.4904 for R = 1/2 on 33 282, 132 098, 526 338 DoFs, the gap shrinking
-   * by 1.53 ≈ 2^{2/3} per refinement). The plain update then overshoots:
+   * O(h^{−1/3}) layers (benchmarks/README.md, "The prediction of the active
+   * set, before and after", measures it). The plain update then overshoots:
    * the first solve penetrates over a band wider than the missing one, all
    * of it is activated, and the surplus is released one layer per
    * iteration, because only its outer rim feels the free vertices beyond
    * (inside the band the load presses the membranes together, so λ_a > 0
-   * there), and the count grew with refinement (3 4 3 5 6 6 iterations on
-   * cycles 1 to 6 of that scene). So when the test wants changes, the next
-   * active set is the test applied not to the iterate itself but to a
-   * prediction from it: n_prediction_sweeps sweeps of projected Jacobi on
-   * the obstacle problem for w with s fixed,
+   * there): the number of iterations grows with refinement. So when the
+   * test wants changes, the next active set is the test applied not to the
+   * iterate itself but to a prediction from it: n_prediction_sweeps sweeps
+   * of projected Jacobi on the obstacle problem for w with s fixed,
    *
    *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
    *
@@ -242,10 +240,11 @@ namespace membranes
    * Where A is an M-matrix, ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and
    * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
    * dominant, hence positive semidefinite, so the sweeps never increase
-   * the energy norm of the error, on any mesh; plain Jacobi diverged on
-   * the curved, locally refined cells of the disk, and l1-Jacobi (the
-   * divisor ‖A_a‖₁) needed more sweeps (4 iterations on Q1 where this
-   * needs 3). Each sweep carries the contact
+   * the energy norm of the error, on any mesh. Plain Jacobi has no such
+   * guarantee where A is not an M-matrix (it diverges on the curved,
+   * locally refined cells of the disk), and l1-Jacobi (the divisor ‖A_a‖₁)
+   * takes half this step where A is an M-matrix, so its prediction lags
+   * (benchmarks/README.md compares both). Each sweep carries the contact
    * information one layer further: penetrated vertices are clamped and
    * lift their neighbours, active vertices pulled apart are released with
    * the ones behind them. Where the predicted test is within the band of
@@ -312,9 +311,10 @@ namespace membranes
     /**
      * The active vertices among the locally relevant ones, by a ghost
      * exchange: the owner of each vertex decides, every process that shares
-     * a cell with it learns the decision. Each is the constraint line
-     * u1(a) = u2(a) of the linear problem of an iteration
-     * (ActiveSetSystem::solve()).
+     * a cell with it learns the decision. ActiveSetSystem::assemble()
+     * imposes them on the linear problem of an iteration: as constraint
+     * lines u1(a) = u2(a) in CoupledSystem, as the projection Π (and, in
+     * the matrix of W, constraint lines W_a = 0) in DecoupledSystem.
      */
     IndexSet
     locally_relevant() const;
@@ -382,9 +382,10 @@ namespace membranes
   private:
     /**
      * Sweeps of projected Jacobi in predicted_changes(): more layers than
-     * the free boundary moves between two nested meshes (measured: 3 to 6
-     * on the degenerate scene; 10 sweeps left one iteration more on its
-     * last two cycles, 40 none).
+     * the free boundary moves between two nested meshes, which grows like
+     * O(h^{−1/3}) at a degenerate free boundary (benchmarks/README.md, "The
+     * prediction of the active set, before and after", measures the layers
+     * and fewer sweeps).
      */
     static constexpr unsigned int n_prediction_sweeps = 40;
 

@@ -104,10 +104,10 @@ namespace membranes
    * stiffer membrane leaves the obstacle problem of a tension ratio 1e8
    * unresolved by eight orders). If the active set has settled but the test
    * is not met (round-off, or vertices kept in the band), the same active
-   * set is solved again with residuals settled_tightening times smaller,
-   * from the same AMG hierarchy; if that does not decrease the residual, or
-   * at `Max active set iterations`, solve() throws ActiveSetNotConverged
-   * with the residual reached.
+   * set is solved again with residuals settled_tightening times smaller
+   * (by the decoupled method from the same AMG hierarchy); if that does not
+   * decrease the residual, or at `Max active set iterations`, solve() throws
+   * ActiveSetNotConverged with the residual reached.
    *
    * <b>Balanced stopping</b> (`Solver/Stopping = balanced`). On a mesh whose
    * discretization error η̃ in the energy norm |||v|||² = Σ_i μ_i |v_i|²_{H1}

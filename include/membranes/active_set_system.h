@@ -63,8 +63,14 @@ namespace membranes
      * for @p active_set (DoFs of the active
      * locally relevant vertices, ActiveSet::locally_relevant(), so that
      * every process knows the constraints of the cells it assembles) needs
-     * before its solve; the constraints of this active set are set in
-     * @p solution, the initial guess.
+     * before its solve: here, not in solve(), the active set is imposed.
+     * CoupledSystem merges its contact lines u1(a) = u2(a) into
+     * AffineConstraints, sets them in @p solution, the initial guess, and
+     * assembles the condensed system; DecoupledSystem imposes W_a = 0 as
+     * the projection Π of the operator of W (its own vector W and the
+     * right-hand side zeroed at the active vertices), and condenses the
+     * lines W_a = 0 into the matrix of W only when the direct solver or the
+     * AMG setup needs that matrix.
      */
     virtual void
     assemble(const DiscreteProblem<dim> &problem,

@@ -49,15 +49,15 @@ namespace membranes
    * condensed with the hanging node constraints and the boundary values,
    * which are the same lines for S and for W), and their right-hand sides
    * are combinations of the lifted loads of the mesh, F_1 + F_2 for S and
-   * (μ2 F_1 − μ1 F_2)/M for W; the first solve() of a mesh forms these and
-   * solves A S = F_1 + F_2 from the initial guess. Every solve() then
-   * imposes W_a = 0 on the active set and solves the obstacle problem's
-   * linear system for W (inactive vertices: Λ_a = 0), and writes U1, U2
-   * into the two blocks of the solution. ActiveSetSolver
-   * computes λ_a by (4.5), and ActiveSet the next active set and the KKT
-   * residual, from it exactly as for the coupled system: the test
-   * Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set test of
-   * this obstacle problem, whose diagonal is μ̄ A_aa.
+   * (μ2 F_1 − μ1 F_2)/M for W, which setup() forms once per mesh. The first
+   * solve() of a mesh solves A S = F_1 + F_2 from the initial guess. Every
+   * assemble() imposes W_a = 0 on the active set, and every solve() solves
+   * the obstacle problem's linear system for W (inactive vertices:
+   * Λ_a = 0) and writes U1, U2 into the two blocks of the solution.
+   * ActiveSetSolver computes λ_a by (4.5), and ActiveSet the next active
+   * set and the KKT residual, from it exactly as for the coupled system:
+   * the test Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set
+   * test of this obstacle problem, whose diagonal is μ̄ A_aa.
    *
    * <h3>The active set: an operator, and a matrix for the preconditioner</h3>
    * The matrix of W of an iteration is μ̄ A with the rows and columns of the
@@ -67,17 +67,19 @@ namespace membranes
    * active vertices to zero, a deal.II LinearOperator composed of the
    * matrix A of the mesh and the diagonal matrices Π and I − Π. The AMG
    * hierarchy does need a matrix, and the right one: the hierarchy of A
-   * itself, seen through Π, needs several times the CG iterations
-   * (benchmarks/README.md), because the restriction of A⁻¹ to the inactive
-   * vertices is not the inverse of the restriction of A. So the
-   * first iteration of a mesh (and one whose CG iterations exceed twice
-   * those of the one that built the hierarchy, plus rebuild_slack) condenses
-   * the matrix of W by AffineConstraints in a cell loop, as step-41 does,
-   * and builds the hierarchy from it; the following iterations, whose
-   * active sets differ from it near the free boundary only, reuse it
-   * through Π. The direct solver factorizes the matrix of W of every
-   * iteration. One matrix per problem and mesh: A (for S, λ_h and the
-   * operator of W) and the matrix of W.
+   * itself, seen through Π, preconditions the operator poorly
+   * (benchmarks/README.md measures it), because the restriction of A⁻¹ to
+   * the inactive vertices is not the inverse of the restriction of A. So
+   * the first iteration of a mesh (and one whose CG iterations exceed twice
+   * those of the one that built the hierarchy, plus rebuild_slack)
+   * condenses the matrix of W by AffineConstraints in a cell loop, as
+   * step-41 does, and builds the hierarchy P from it, μ̄ included; CG is
+   * preconditioned by Π P Π + (I − Π), and the following iterations, whose
+   * active sets differ from it near the free boundary only, reuse P. The
+   * direct solver factorizes the matrix of W of every iteration. One matrix
+   * per problem and mesh: A (for S, λ_h and the operator of W) and the
+   * matrix of W; with cg-amg, the hierarchies of both: that of A for S,
+   * freed after the solve of S, and that of the matrix of W.
    *
    * Both scalar problems live on the DoFHandler of the mesh, whose DoFs map
    * one to one to the vertices: S, W and the blocks U1, U2 of the solution

@@ -56,9 +56,14 @@ namespace membranes
    * It holds
    * - A = (∫ ∇φ_a·∇φ_b), condensed by AffineConstraints with the hanging
    *   node constraints and the boundary values: the rows and columns of
-   *   constrained DoFs eliminated, Σ_K A_K(j, j) on their diagonal. This is
-   *   the matrix of the linear problems of DecoupledSystem and the one
-   *   AMG hierarchy of the mesh is built from it;
+   *   constrained DoFs eliminated, Σ_K A_K(j, j) on their diagonal. It is
+   *   the matrix of S in DecoupledSystem, whose solve_s() builds an AMG
+   *   hierarchy from it, the matrix CG applies to W through the projection
+   *   Π, and the operator of λ_a in DiscreteAction. The other hierarchy
+   *   of the decoupled method on a mesh is built from the condensed matrix
+   *   of W (μ̄ A with the rows and columns of the active vertices
+   *   eliminated; anew only when CG slows down), and CoupledSystem builds
+   *   one from its system matrix on every iteration;
    * - the loads F_i = (∫ f_i φ_a), condensed with the hanging node
    *   constraints, and the lifted loads F_i − μ_i A_{·,∂} g_i, condensed
    *   like A with the boundary values g_1 = g, g_2 = g2: the right-hand

@@ -24,9 +24,9 @@ namespace membranes
    *   (TrilinosWrappers::SolverDirect with direct_solver_package) of the
    *   distributed matrix itself, on any number of processes.
    * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
-   *   multigrid, with one constant near-null-space mode per component of
-   *   the DoFHandler (per membrane for (u1, u2), one for s or w).
-   * - `auto`: direct up to direct_solver_dof_limit DoFs on one process,
+   *   multigrid, with the constant near-null-space modes reinit() is given:
+   *   one per block of the coupled system of (u1, u2), one for s or w.
+   * - `auto`: direct up to direct_solver_dof_limit unknowns on one process,
    *   cg-amg otherwise.
    *
    * CG stops at the residual norm it is given (the active set method
@@ -35,9 +35,14 @@ namespace membranes
    * meshes), and starts from the vector it is given (the previous active set
    * iterate, or the interpolated solution of the previous mesh), so later
    * iterations of the active set method are cheap. It runs on any operator
-   * with a vmult(): a matrix, or a LinearOperator composed from it (the
-   * projection of DecoupledSystem, the scaling of CoupledSystem), with the
-   * AMG hierarchy of initialize_preconditioner() composed the same way.
+   * with a vmult(): a matrix, or a deal.II LinearOperator composed from one,
+   * with a preconditioner composed from the AMG hierarchy P of
+   * initialize_preconditioner(). DecoupledSystem solves for S on the
+   * Laplacian A of the mesh with the hierarchy of A, and for W on
+   * Π (μ̄ A) Π + (I − Π) with Π P Π + (I − Π), P the hierarchy of the
+   * condensed matrix of W (μ̄ included in that matrix), Π the projection
+   * onto the inactive vertices; CoupledSystem solves on the scaled system
+   * D K D with D⁻¹ P D⁻¹, P the hierarchy of K.
    */
   template <int dim>
   class LinearSolver

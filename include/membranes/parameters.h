@@ -220,7 +220,7 @@ namespace membranes::Parameters
   /** Subsection `Solver`: the primal-dual active set method. */
   struct Solver
   {
-    /** Coupled (u1, u2), decoupled (s, w), or the faster of the two. */
+    /** Coupled (u1, u2), decoupled (s, w), or auto (always decoupled). */
     SolverMethod method;
     LinearSolverType
                  linear_solver; ///< Sparse LU, CG with AMG, or chosen by size.
