@@ -160,6 +160,7 @@ namespace membranes
                             const MPI_Comm             mpi_communicator)
     : parameters(parameters)
     , data(data)
+    , mpi_communicator(mpi_communicator)
     , history(mpi_communicator)
     , predicted_action(discretization, data)
   {}
@@ -170,7 +171,6 @@ namespace membranes
   void
   ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
   {
-    problem         = &discrete_problem;
     active_vertices = IndexSet(discrete_problem.locally_owned_dofs().size());
     active_flags.assign(discrete_problem.vertices().size(), false);
     predicted_action.reinit(discrete_problem);
@@ -187,30 +187,30 @@ namespace membranes
     reinit(discrete_problem);
     const double epsilon  = parameters.tolerance;
     const double u_scale  = displacement_scale(solution);
-    const auto  &vertices = problem->vertices();
+    const auto  &vertices = discrete_problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a      = vertices[k];
         const double c      = contact_stiffness(a);
         const double lambda = ghosted_lambda_h[a.dof] / (c * u_scale);
-        const double w      = nodal_w(k, solution) / u_scale;
+        const double w      = discrete_problem.nodal_w(k, solution) / u_scale;
         const bool   degenerate =
           std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
         if (!degenerate && lambda - w > 0)
           active_vertices.add_index(a.dof);
       }
     active_vertices.compress();
-    set_flags();
+    set_flags(discrete_problem);
   }
 
 
 
   template <int dim>
   void
-  ActiveSet<dim>::set_flags()
+  ActiveSet<dim>::set_flags(const DiscreteProblem<dim> &problem)
   {
     // Both are sorted by the DoF.
-    const auto &vertices = problem->vertices();
+    const auto &vertices = problem.vertices();
     auto        active   = active_vertices.begin();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
@@ -236,28 +236,26 @@ namespace membranes
   types::global_dof_index
   ActiveSet<dim>::n_active_vertices() const
   {
-    return Utilities::MPI::sum(active_vertices.n_elements(),
-                               problem->get_mpi_communicator());
+    return Utilities::MPI::sum(active_vertices.n_elements(), mpi_communicator);
   }
 
 
 
   template <int dim>
   IndexSet
-  ActiveSet<dim>::locally_relevant() const
+  ActiveSet<dim>::locally_relevant(const DiscreteProblem<dim> &problem) const
   {
-    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
-    VectorType     owned_flags(problem->locally_owned_dofs(), mpi_communicator);
+    VectorType owned_flags(problem.locally_owned_dofs(), mpi_communicator);
     for (const auto dof : active_vertices)
       owned_flags[dof] = 1;
     owned_flags.compress(VectorOperation::insert);
-    VectorType flags(problem->locally_owned_dofs(),
-                     problem->locally_relevant_dofs(),
+    VectorType flags(problem.locally_owned_dofs(),
+                     problem.locally_relevant_dofs(),
                      mpi_communicator);
     flags = owned_flags;
 
     IndexSet relevant_active_set(active_vertices.size());
-    for (const auto dof : problem->locally_relevant_vertices())
+    for (const auto dof : problem.locally_relevant_vertices())
       if (flags[dof] > 0)
         relevant_active_set.add_index(dof);
     relevant_active_set.compress();
@@ -277,17 +275,18 @@ namespace membranes
 
   template <int dim>
   KKTDefects
-  ActiveSet<dim>::kkt_defects(const DiscreteAction<dim> &action,
-                              const BlockVectorType     &solution) const
+  ActiveSet<dim>::kkt_defects(const DiscreteProblem<dim> &problem,
+                              const DiscreteAction<dim>  &action,
+                              const BlockVectorType      &solution) const
   {
     const double max = std::numeric_limits<double>::max();
     KKTDefects   defects{0, 0, max, max, max, 0};
-    const auto  &vertices = problem->vertices();
+    const auto  &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a             = vertices[k];
         const double d             = a.dual_cell_measure;
-        const double w             = nodal_w(k, solution);
+        const double w             = problem.nodal_w(k, solution);
         const double lambda        = action.lambda(k);
         const double contact_force = lambda * d;
         defects.sum_equilibrium =
@@ -305,7 +304,6 @@ namespace membranes
         defects.complementarity =
           std::max(defects.complementarity, std::abs(contact_force * w));
       }
-    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
     for (double *maximum : {&defects.sum_equilibrium,
                             &defects.contact_equilibrium,
                             &defects.complementarity})
@@ -320,20 +318,21 @@ namespace membranes
 
   template <int dim>
   std::vector<StatusChange>
-  ActiveSet<dim>::wanted_changes(const DiscreteAction<dim> &action,
-                                 const BlockVectorType     &solution) const
+  ActiveSet<dim>::wanted_changes(const DiscreteProblem<dim> &problem,
+                                 const DiscreteAction<dim>  &action,
+                                 const BlockVectorType      &solution) const
   {
     const double epsilon = parameters.tolerance;
     const double u_scale = displacement_scale(solution);
 
     std::vector<StatusChange> changes;
-    const auto               &vertices = problem->vertices();
+    const auto               &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a = vertices[k];
         const double violation =
           is_active(k) ? -action.lambda(k) / (contact_stiffness(a) * u_scale) :
-                         -nodal_w(k, solution) / u_scale;
+                         -problem.nodal_w(k, solution) / u_scale;
         if (violation > epsilon)
           changes.push_back({a.dof, violation / epsilon});
       }
@@ -353,7 +352,8 @@ namespace membranes
 
   template <int dim>
   typename ActiveSet<dim>::Update
-  ActiveSet<dim>::update(const BlockVectorType           &solution,
+  ActiveSet<dim>::update(const DiscreteProblem<dim>      &problem,
+                         const BlockVectorType           &solution,
                          const std::vector<StatusChange> &changes)
   {
     Update                           update;
@@ -361,18 +361,17 @@ namespace membranes
     std::vector<StatusChange>        predicted;
     if (history.cycles() == 0)
       {
-        predicted = predicted_changes(solution, changes);
+        predicted = predicted_changes(problem, solution, changes);
         update.predicted_force_scales =
           std::array<double, 2>{{predicted_action.force_scale(),
                                  predicted_action.contact_force_scale()}};
-        if (Utilities::MPI::sum(predicted.size(),
-                                problem->get_mpi_communicator()) > 0)
+        if (Utilities::MPI::sum(predicted.size(), mpi_communicator) > 0)
           next = &predicted;
       }
     static_cast<ActiveSetHistory::Step &>(update) =
       history.next(active_vertices, *next);
     active_vertices = update.active_set;
-    set_flags();
+    set_flags(problem);
     return update;
   }
 
@@ -381,14 +380,15 @@ namespace membranes
   template <int dim>
   std::vector<StatusChange>
   ActiveSet<dim>::predicted_changes(
+    const DiscreteProblem<dim>      &problem,
     const BlockVectorType           &solution,
     const std::vector<StatusChange> &plain_changes)
   {
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     const double epsilon   = parameters.tolerance;
     const double u_scale   = displacement_scale(solution);
-    const auto  &vertices  = problem->vertices();
-    const auto  &positions = problem->local_positions();
+    const auto  &vertices  = problem.vertices();
+    const auto  &positions = problem.local_positions();
 
     // Projected Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
@@ -397,8 +397,8 @@ namespace membranes
     // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem): one product
     // with A on the scalar W per sweep, on contiguous local arrays. In the
     // end U1 moves by μ2/M and U2 by −μ1/M of the change of W.
-    const double *const lifted_1 = problem->lifted_loads(0).begin();
-    const double *const lifted_2 = problem->lifted_loads(1).begin();
+    const double *const lifted_1 = problem.lifted_loads(0).begin();
+    const double *const lifted_2 = problem.lifted_loads(1).begin();
     BlockVectorType     iterate  = solution;
     VectorType          w        = iterate.block(0);
     w -= iterate.block(1);
@@ -417,7 +417,7 @@ namespace membranes
     const double *const product = stiffness_w.begin();
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
-        problem->laplace_matrix().vmult(stiffness_w, w);
+        problem.laplace_matrix().vmult(stiffness_w, w);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
             const unsigned int p = positions[k];
@@ -439,7 +439,7 @@ namespace membranes
         const auto  &a = vertices[k];
         const double c = contact_stiffness(a);
         const double test =
-          (predicted_action.lambda(k) - c * nodal_w(k, iterate)) /
+          (predicted_action.lambda(k) - c * problem.nodal_w(k, iterate)) /
           (c * u_scale);
         const double violation = is_active(k) ? -test : test;
         if (violation > epsilon)

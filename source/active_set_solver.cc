@@ -134,22 +134,23 @@ namespace membranes
 
   template <int dim>
   void
-  ActiveSetSolver<dim>::evaluate(const DiscreteAction<dim> &action,
-                                 const VectorType          &solution,
-                                 const ActiveSet<dim>      &active_set,
-                                 const StoppingState       &stopping,
-                                 Statistics                &statistics) const
+  ActiveSetSolver<dim>::evaluate(const DiscreteProblem<dim> &problem,
+                                 const DiscreteAction<dim>  &action,
+                                 const VectorType           &solution,
+                                 const ActiveSet<dim>       &active_set,
+                                 const StoppingState        &stopping,
+                                 Statistics                 &statistics) const
   {
     const double tiny = std::numeric_limits<double>::min();
     statistics.kkt_residual =
-      active_set.kkt_defects(action, solution)
+      active_set.kkt_defects(problem, action, solution)
         .relative_residual(std::max(action.force_scale(), tiny),
                            std::max(action.contact_force_scale(), tiny),
                            displacement_scale(solution));
     if (stopping.balanced)
       {
         statistics.linearization_estimate =
-          linearization_estimate(action, solution, active_set);
+          linearization_estimate(problem, action, solution, active_set);
         statistics.algebraic_estimate = algebraic_estimate(action, active_set);
       }
   }
@@ -254,13 +255,14 @@ namespace membranes
 
   template <int dim>
   void
-  ActiveSetSolver<dim>::update(ActiveSet<dim>                  &active_set,
+  ActiveSetSolver<dim>::update(const DiscreteProblem<dim>      &problem,
+                               ActiveSet<dim>                  &active_set,
                                const VectorType                &solution,
                                const std::vector<StatusChange> &changes,
                                const unsigned int               iteration,
                                StoppingState                   &stopping) const
   {
-    const auto update = active_set.update(solution, changes);
+    const auto update = active_set.update(problem, solution, changes);
     if (update.cycle_to)
       pcout << "      cycle: iteration " << iteration + 1
             << " would repeat the active set of iteration "
@@ -298,9 +300,10 @@ namespace membranes
   template <int dim>
   double
   ActiveSetSolver<dim>::linearization_estimate(
-    const DiscreteAction<dim> &action,
-    const VectorType          &solution,
-    const ActiveSet<dim>      &active_set) const
+    const DiscreteProblem<dim> &problem,
+    const DiscreteAction<dim>  &action,
+    const VectorType           &solution,
+    const ActiveSet<dim>       &active_set) const
   {
     double      energy   = 0;
     const auto &vertices = action.vertices();
@@ -311,7 +314,7 @@ namespace membranes
         const double step = active_set.is_active(k) ?
                               2 * std::max(-action.lambda(k), 0.) *
                                 a.dual_cell_measure / (data.mu_bar * norm) :
-                              std::max(-active_set.nodal_w(k, solution), 0.);
+                              std::max(-problem.nodal_w(k, solution), 0.);
         energy += data.mu_bar * norm * step * step;
       }
     return std::sqrt(Utilities::MPI::sum(energy, mpi_communicator));
@@ -359,7 +362,7 @@ namespace membranes
           TimerOutput::Scope scope(timer, "assembly");
           system->assemble(problem,
                            dof_handler,
-                           active_set.locally_relevant(),
+                           active_set.locally_relevant(problem),
                            solution);
         }
         TimerOutput::Scope scope(timer, "solve");
@@ -372,18 +375,23 @@ namespace membranes
                       linear_tolerances(stopping),
                       statistics);
         compute_action(action, solution, stopping);
-        const auto changes = active_set.wanted_changes(action, solution);
+        const auto changes =
+          active_set.wanted_changes(problem, action, solution);
         const auto n_changes =
           Utilities::MPI::sum<types::global_dof_index>(changes.size(),
                                                        mpi_communicator);
-        evaluate(action, solution, active_set, stopping, statistics);
+        evaluate(problem, action, solution, active_set, stopping, statistics);
         print_iteration(
           statistics, active_set, n_changes, linear_iterations, stopping);
         if (stops(statistics, n_changes, stopping))
           break;
         if (n_changes > 0)
-          update(
-            active_set, solution, changes, statistics.iterations, stopping);
+          update(problem,
+                 active_set,
+                 solution,
+                 changes,
+                 statistics.iterations,
+                 stopping);
       }
     // The matrices and the AMG hierarchy of this mesh are not needed any more.
     system->clear();

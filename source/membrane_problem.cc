@@ -319,8 +319,9 @@ namespace membranes
   {
     lambda_h = action.lambda_h(hanging_node_constraints);
 
-    const KKTDefects defects = active_set.kkt_defects(action, ghosted_solution);
-    const double     force_scale =
+    const KKTDefects defects =
+      active_set.kkt_defects(discrete_problem, action, ghosted_solution);
+    const double force_scale =
       std::max(action.force_scale(), std::numeric_limits<double>::min());
     const double u_scale = displacement_scale(ghosted_solution);
     // The active set lives on V_h only: no hanging vertex is ever active.

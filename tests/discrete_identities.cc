@@ -364,7 +364,8 @@ namespace
     check_true(name + ": the vertex is active",
                problem.active_set.is_active(k));
     check(name + ": (4.8) lambda_a (u1h - u2h)(a)",
-          action.lambda(k) * problem.active_set.nodal_w(k, problem.solution),
+          action.lambda(k) *
+            problem.discrete_problem.nodal_w(k, problem.solution),
           0,
           lambda_contact * std::abs(u));
   }
@@ -459,7 +460,7 @@ namespace
           2.);
     check("Q1 2x2, apart: (4.8) lambda_a (u1h - u2h)(a)",
           apart.action.lambda(ka) *
-            apart.active_set.nodal_w(ka, apart.solution),
+            apart.discrete_problem.nodal_w(ka, apart.solution),
           0,
           2. * 15. / 64.);
   }

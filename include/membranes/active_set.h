@@ -181,8 +181,8 @@ namespace membranes
    * initial value on a new mesh and its update from an iterate. The linear
    * systems impose it (ActiveSetSystem::assemble()).
    *
-   * With W_a = u1h(a) − u2h(a) (ActiveSet::nodal_w()) and the nodal multiplier
-   * Λ_a = λ_a of (4.5), the active set is
+   * With W_a = u1h(a) − u2h(a) (DiscreteProblem::nodal_w()) and the nodal
+   * multiplier Λ_a = λ_a of (4.5), the active set is
    *
    *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a
    *
@@ -309,7 +309,8 @@ namespace membranes
     n_active_vertices() const;
 
     /**
-     * The active vertices among the locally relevant ones, by a ghost
+     * The active vertices among the locally relevant ones of the mesh of
+     * @p problem, by a ghost
      * exchange: the owner of each vertex decides, every process that shares
      * a cell with it learns the decision. ActiveSetSystem::assemble()
      * imposes them on the linear problem of an iteration: as constraint
@@ -317,20 +318,7 @@ namespace membranes
      * the matrix of W, constraint lines W_a = 0) in DecoupledSystem.
      */
     IndexSet
-    locally_relevant() const;
-
-    /**
-     * W_a = u1h(a) − u2h(a) at the locally owned vertex k of
-     * DiscreteProblem::vertices(), read from the local storage of the two
-     * blocks of @p solution at the position of the vertex: no search per
-     * entry.
-     */
-    double
-    nodal_w(const unsigned int k, const BlockVectorType &solution) const
-    {
-      const unsigned int p = problem->local_positions()[k];
-      return solution.block(0).begin()[p] - solution.block(1).begin()[p];
-    }
+    locally_relevant(const DiscreteProblem<dim> &problem) const;
 
     /** c_a = μ̄ ∫|∇φ_a|² / d_a. */
     double
@@ -341,8 +329,9 @@ namespace membranes
      * λ_a in @p action.
      */
     KKTDefects
-    kkt_defects(const DiscreteAction<dim> &action,
-                const BlockVectorType     &solution) const;
+    kkt_defects(const DiscreteProblem<dim> &problem,
+                const DiscreteAction<dim>  &action,
+                const BlockVectorType      &solution) const;
 
     /**
      * The locally owned vertices whose status the test wants to change on
@@ -350,8 +339,9 @@ namespace membranes
      * outside the band of indifference, by increasing DoF.
      */
     std::vector<StatusChange>
-    wanted_changes(const DiscreteAction<dim> &action,
-                   const BlockVectorType     &solution) const;
+    wanted_changes(const DiscreteProblem<dim> &problem,
+                   const DiscreteAction<dim>  &action,
+                   const BlockVectorType      &solution) const;
 
     /** Start the record of the sets visited on this mesh (ActiveSetHistory). */
     void
@@ -376,7 +366,8 @@ namespace membranes
      * cycling, ActiveSetHistory::next().
      */
     Update
-    update(const BlockVectorType           &solution,
+    update(const DiscreteProblem<dim>      &problem,
+           const BlockVectorType           &solution,
            const std::vector<StatusChange> &changes);
 
   private:
@@ -397,17 +388,21 @@ namespace membranes
      * in `predicted_action`.
      */
     std::vector<StatusChange>
-    predicted_changes(const BlockVectorType           &solution,
+    predicted_changes(const DiscreteProblem<dim>      &problem,
+                      const BlockVectorType           &solution,
                       const std::vector<StatusChange> &plain_changes);
 
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
 
-    /** active_flags from active_vertices, in one pass over both. */
+    /**
+     * active_flags from active_vertices, in one pass over both and the
+     * vertices of @p problem.
+     */
     void
-    set_flags();
+    set_flags(const DiscreteProblem<dim> &problem);
 
-    const DiscreteProblem<dim> *problem;
+    const MPI_Comm mpi_communicator;
     /** The locally owned active vertices. */
     IndexSet active_vertices;
     /**

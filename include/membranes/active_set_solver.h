@@ -248,7 +248,8 @@ namespace membranes
      * prediction into @p stopping.
      */
     void
-    update(ActiveSet<dim>                  &active_set,
+    update(const DiscreteProblem<dim>      &problem,
+           ActiveSet<dim>                  &active_set,
            const VectorType                &solution,
            const std::vector<StatusChange> &changes,
            const unsigned int               iteration,
@@ -271,11 +272,12 @@ namespace membranes
      * with balanced stopping, η_lin and η_alg, into @p statistics.
      */
     void
-    evaluate(const DiscreteAction<dim> &action,
-             const VectorType          &solution,
-             const ActiveSet<dim>      &active_set,
-             const StoppingState       &stopping,
-             Statistics                &statistics) const;
+    evaluate(const DiscreteProblem<dim> &problem,
+             const DiscreteAction<dim>  &action,
+             const VectorType           &solution,
+             const ActiveSet<dim>       &active_set,
+             const StoppingState        &stopping,
+             Statistics                 &statistics) const;
 
     /**
      * Whether the method stops after the iteration of @p statistics, whose
@@ -313,9 +315,10 @@ namespace membranes
      * documentation), over all processes.
      */
     double
-    linearization_estimate(const DiscreteAction<dim> &action,
-                           const VectorType          &solution,
-                           const ActiveSet<dim>      &active_set) const;
+    linearization_estimate(const DiscreteProblem<dim> &problem,
+                           const DiscreteAction<dim>  &action,
+                           const VectorType           &solution,
+                           const ActiveSet<dim>       &active_set) const;
 
     /** η_alg of an iterate with λ_a in @p action, over all processes. */
     double

@@ -7,6 +7,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/discretization.h>
@@ -170,6 +171,19 @@ namespace membranes
     /** The locally owned vertices of V_h, by increasing DoF. */
     const std::vector<Vertex> &
     vertices() const;
+
+    /**
+     * W_a = u1h(a) − u2h(a) at the locally owned vertex k of vertices(),
+     * read from the local storage of the two blocks of @p solution at the
+     * position of the vertex: no search per entry.
+     */
+    double
+    nodal_w(const unsigned int                        k,
+            const TrilinosWrappers::MPI::BlockVector &solution) const
+    {
+      const unsigned int p = positions[k];
+      return solution.block(0).begin()[p] - solution.block(1).begin()[p];
+    }
 
     /**
      * The positions of the DoFs of vertices() in the local storage of a
