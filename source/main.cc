@@ -20,7 +20,7 @@
 #include <filesystem>
 #include <iostream>
 #include <membranes/membrane_problem.h>
-#include <membranes/parameters.h>
+#include <membranes/scene/parameters.h>
 #include <sched.h>
 #include <string>
 #include <vector>

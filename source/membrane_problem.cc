@@ -3,15 +3,13 @@
 #include <deal.II/distributed/grid_refinement.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/grid/grid_refinement.h>
-#include <filesystem>
 #include <limits>
 #include <map>
-#include <membranes/error_estimator.h>
-#include <membranes/error_norms.h>
-#include <membranes/flux_equilibration.h>
-#include <membranes/flux_reconstruction.h>
+#include <membranes/estimators/error_estimator.h>
+#include <membranes/estimators/error_norms.h>
+#include <membranes/flux/flux_equilibration.h>
+#include <membranes/flux/flux_reconstruction.h>
 #include <membranes/membrane_problem.h>
-#include <unistd.h>
 
 namespace membranes
 {
@@ -70,7 +68,7 @@ namespace membranes
   void
   MembraneProblem<dim>::make_grid()
   {
-    check_output_directory();
+    output_directory.check();
     try
       {
         create_mesh(parameters.geometry, *triangulation);
@@ -84,79 +82,6 @@ namespace membranes
     data.check_exact_solution(*triangulation,
                               *discretization.mapping,
                               discretization.cell_quadrature);
-  }
-
-
-
-  /**
-   * Whether `Output/Directory` can be created, found out before the first
-   * cycle and without leaving anything behind: every part of its path that
-   * exists must be a directory, and in the deepest one that exists a
-   * directory must be creatable (a probe, removed at once; a read-only or
-   * virtual file system such as /proc refuses it). The directory itself is
-   * created when the run claims it (OutputDirectory::claim()), after the
-   * checks of the data on the coarse mesh.
-   */
-  template <int dim>
-  void
-  MembraneProblem<dim>::check_output_directory() const
-  {
-    namespace fs = std::filesystem;
-    std::string problem;
-    if (pcout.is_active())
-      {
-        std::error_code error;
-        const fs::path  directory =
-          fs::absolute(fs::path(parameters.output.directory).lexically_normal(),
-                       error);
-        // Up to the deepest part of the path that exists; any other error
-        // than a missing part (a file in the path, no permission) is the
-        // answer.
-        fs::path existing = directory;
-        while (!error &&
-               fs::status(existing, error).type() == fs::file_type::not_found &&
-               existing != existing.parent_path())
-          {
-            error.clear();
-            existing = existing.parent_path();
-          }
-        // The probe: the first missing part of the path itself (its name
-        // may be too long), or a new name inside the existing directory.
-        const fs::path probe =
-          existing == directory ?
-            existing / (".membranes-probe-" + std::to_string(::getpid())) :
-            existing / *fs::relative(directory, existing).begin();
-        if (error)
-          problem = error.message();
-        else if (!fs::is_directory(existing))
-          problem = existing.string() + " is not a directory";
-        else if (!fs::create_directory(probe, error))
-          problem = "no directory can be made in " + existing.string() +
-                    (error ? " (" + error.message() + ")" : "");
-        else
-          fs::remove(probe, error);
-      }
-    problem = Utilities::MPI::broadcast(mpi_communicator, problem, 0);
-    if (!problem.empty())
-      throw Parameters::invalid_entry("Output/Directory",
-                                      parameters.output.directory,
-                                      "cannot create this directory (" +
-                                        problem + ")");
-  }
-
-
-
-  /** A directory for output besides `Output/Directory` (unconverged/). */
-  template <int dim>
-  void
-  MembraneProblem<dim>::create_output_directory(
-    const std::string &directory) const
-  {
-    if (pcout.is_active())
-      create_directory(directory);
-    // The other processes write their own pieces into it.
-    const int ierr = MPI_Barrier(mpi_communicator);
-    AssertThrowMPI(ierr);
   }
 
 
@@ -493,10 +418,9 @@ namespace membranes
     lambda_h         = action.lambda_h(hanging_node_constraints);
 
     Parameters::Output output = parameters.output;
-    output.directory += "/unconverged";
-    output.write_vtu          = true;
+    output.directory = output_directory.create_subdirectory("unconverged");
+    output.write_vtu = true;
     output.write_nodal_values = true;
-    create_output_directory(output.directory);
     const std::vector<std::string> files =
       FieldOutput<dim>(output, discretization, mpi_communicator)
         .write(record.mesh.cycle,

@@ -26,7 +26,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <iostream>
-#include <membranes/active_set.h>
+#include <membranes/active_set/active_set.h>
 
 using namespace dealii;
 using namespace membranes;

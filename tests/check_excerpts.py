@@ -6,7 +6,7 @@ Usage::
     check_excerpts.py DOCUMENT
 
 Every fenced ``cpp`` block of DOCUMENT must start with a comment line naming
-one file of the source tree (``// source/active_set.cc``). The lines after
+one file of the source tree (``// source/active_set/active_set.cc``). The lines after
 it must occur in that file, in order: the block is cut into pieces at the
 lines ``// ...`` (code left out), each piece must stand in the file as
 consecutive lines (blank lines and the indentation of each line do not

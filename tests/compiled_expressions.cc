@@ -12,7 +12,7 @@
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
 #include <iostream>
-#include <membranes/compiled_function.h>
+#include <membranes/scene/compiled_function.h>
 #include <muParser.h>
 
 using namespace dealii;

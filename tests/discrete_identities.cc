@@ -114,14 +114,14 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
-#include <membranes/active_set.h>
-#include <membranes/active_set_solver.h>
-#include <membranes/discrete_action.h>
-#include <membranes/discrete_problem.h>
-#include <membranes/discretization.h>
-#include <membranes/flux_reconstruction.h>
-#include <membranes/parameters.h>
-#include <membranes/problem_data.h>
+#include <membranes/active_set/active_set.h>
+#include <membranes/active_set/active_set_solver.h>
+#include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/flux/flux_reconstruction.h>
+#include <membranes/mesh/discrete_problem.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/scene/parameters.h>
+#include <membranes/scene/problem_data.h>
 #include <string>
 
 using namespace dealii;

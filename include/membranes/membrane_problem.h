@@ -10,16 +10,16 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/numerics/solution_transfer.h>
-#include <membranes/active_set.h>
-#include <membranes/active_set_solver.h>
-#include <membranes/discrete_action.h>
-#include <membranes/discrete_problem.h>
-#include <membranes/discretization.h>
-#include <membranes/field_output.h>
-#include <membranes/output_directory.h>
-#include <membranes/parameters.h>
-#include <membranes/problem_data.h>
-#include <membranes/report.h>
+#include <membranes/active_set/active_set.h>
+#include <membranes/active_set/active_set_solver.h>
+#include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/mesh/discrete_problem.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/output/field_output.h>
+#include <membranes/output/output_directory.h>
+#include <membranes/output/report.h>
+#include <membranes/scene/parameters.h>
+#include <membranes/scene/problem_data.h>
 #include <memory>
 
 namespace membranes
@@ -80,10 +80,6 @@ namespace membranes
 
     void
     make_grid();
-    void
-    check_output_directory() const;
-    void
-    create_output_directory(const std::string &directory) const;
     void
     setup_system();
     void

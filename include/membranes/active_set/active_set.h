@@ -1,0 +1,420 @@
+#ifndef membranes_active_set_h
+#define membranes_active_set_h
+
+#include <array>
+#include <deal.II/base/index_set.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/mesh/discrete_problem.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/scene/parameters.h>
+#include <membranes/scene/problem_data.h>
+#include <optional>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * A vertex whose status the active set method wants to change: its DoF
+   * and by how much its test is violated, in units of the band of
+   * indifference (see ActiveSet), so at least 1.
+   */
+  struct StatusChange
+  {
+    types::global_dof_index dof;
+    double                  violation;
+
+    /** For Utilities::MPI::all_gather(). */
+    template <class Archive>
+    void
+    serialize(Archive &archive, const unsigned int)
+    {
+      archive &dof &violation;
+    }
+  };
+
+
+
+  /**
+   * The active sets the active set method has visited on one mesh, and the
+   * remedy against cycling.
+   *
+   * The plain update changes the status of every vertex whose test is
+   * violated. For an M-matrix (non-obtuse meshes) this converges
+   * monotonically, but in general the primal-dual active set method, a
+   * semismooth Newton method for the complementarity problem, may cycle:
+   * return to an active set it has already visited, and go round for ever.
+   * Each update is therefore checked against all active sets visited on
+   * the current mesh (the initial one included). When it would return to
+   * one of them, the update is restricted to the vertices with the largest
+   * violations: on the r-th cycle detected on this mesh to ⌈n / 2^r⌉ of the
+   * n vertices that want to change; if that set was visited too, r is
+   * raised again. Once the share is down to one vertex, the method
+   * continues on this mesh with Murty's least-index rule: change only the
+   * wanted vertex of least DoF index. That rule terminates for every linear
+   * complementarity problem with a P-matrix (K. G. Murty, Note on a
+   * Bard-type scheme for solving the complementarity problem, Opsearch 11,
+   * 1974), and ours has one: eliminating the displacements leaves the Schur
+   * complement of the symmetric positive definite system on the contact
+   * vertices, which is symmetric positive definite. The halving can only happen
+   * log2(n) times, so the method terminates on every mesh; a cycle costs
+   * iterations, not convergence.
+   *
+   * Under MPI each process keeps the locally owned part of the sets; the
+   * comparisons and the choice of vertices are global.
+   */
+  class ActiveSetHistory
+  {
+  public:
+    explicit ActiveSetHistory(const MPI_Comm mpi_communicator);
+
+    /** Forget all, and start a new mesh at @p initial_active_set. */
+    void
+    restart(const IndexSet &initial_active_set);
+
+    /** What one update did. */
+    struct Step
+    {
+      /** The next active set (locally owned part). */
+      IndexSet active_set;
+      /** How many vertices wanted to change, and how many did. */
+      types::global_dof_index wanted, changed;
+      /**
+       * The number of the visited set (0 for the initial one, k for the
+       * set of iteration k + 1) that the plain update would have
+       * returned to, if a cycle was detected.
+       */
+      std::optional<unsigned int> cycle_to;
+      /** Whether the update followed Murty's least-index rule. */
+      bool least_index_rule;
+    };
+
+    /**
+     * The active set after @p active_set (the last one visited), changed
+     * at the locally owned vertices @p changes or, if that would close a
+     * cycle, at the part of them that the remedy allows. The result is
+     * recorded as visited.
+     */
+    Step
+    next(const IndexSet &active_set, const std::vector<StatusChange> &changes);
+
+    /** Cycles detected since restart(). */
+    unsigned int
+    cycles() const;
+
+    /**
+     * The plain update: @p active_set with the status of the vertices
+     * @p dofs (locally owned DoFs) changed.
+     */
+    static IndexSet
+    toggled(const IndexSet                             &active_set,
+            const std::vector<types::global_dof_index> &dofs);
+
+  private:
+    /** The number of the visited set equal to @p set (on all processes). */
+    std::optional<unsigned int>
+    find(const IndexSet &set) const;
+
+    const MPI_Comm        mpi_communicator;
+    std::vector<IndexSet> visited;
+    unsigned int          n_cycles;
+    bool                  least_index_rule;
+  };
+
+
+
+  /**
+   * The defects of the KKT conditions of (3.4) with the multiplier (4.7) of
+   * an iterate, as maxima and minima over the vertices a of V_h (all
+   * processes), in the units of the problem: with W_a = u1h(a) − u2h(a),
+   * λ_a of DiscreteAction::lambda() and d_a,
+   * - Prop. 12 (equilibrium of s): max |λ_1a − λ_2a| d_a;
+   * - equilibrium of w: max |λ_a d_a| on the inactive vertices;
+   * - primal feasibility (W_a ≥ 0): min W_a;
+   * - dual feasibility (λ_a ≥ 0): min λ_a and min λ_a d_a;
+   * - complementarity (4.8): max |λ_a d_a W_a|.
+   * The stopping test of the active set method (relative_residual()) and
+   * the report both read them.
+   */
+  struct KKTDefects
+  {
+    double sum_equilibrium;
+    double contact_equilibrium;
+    double min_w;
+    double min_lambda;
+    double min_contact_force;
+    double complementarity;
+
+    /**
+     * The relative KKT residual, the largest of the defects of the two
+     * problems of DecoupledSystem, each on its own scale: F_∞
+     * (@p force_scale) and F^w_∞ (@p contact_force_scale) of DiscreteAction,
+     * U_∞ = max|U| (@p displacement_scale):
+     * - equilibrium of s / F_∞;
+     * - equilibrium of w / F^w_∞;
+     * - primal feasibility: max(−W_a)⁺ / U_∞;
+     * - dual feasibility: max(−λ_a d_a)⁺ / F^w_∞;
+     * - complementarity / (F^w_∞ U_∞).
+     * All are maxima over the vertices, so none grows with the size of the
+     * mesh, and all are unchanged when the data are scaled or the
+     * membranes swap roles.
+     */
+    double
+    relative_residual(const double force_scale,
+                      const double contact_force_scale,
+                      const double displacement_scale) const;
+  };
+
+
+
+  /** U_∞ = max|U| of @p solution, both blocks (never zero: it divides). */
+  double
+  displacement_scale(const TrilinosWrappers::MPI::BlockVector &solution);
+
+
+
+  /**
+   * The active set of the primal-dual active set method (ActiveSetSolver):
+   * the set A ⊂ V_h of the vertices where the membranes are in contact, its
+   * initial value on a new mesh and its update from an iterate. The linear
+   * systems impose it (ActiveSetSystem::assemble()).
+   *
+   * With W_a = u1h(a) − u2h(a) (DiscreteProblem::nodal_w()) and the nodal
+   * multiplier Λ_a = λ_a of (4.5), the active set is
+   *
+   *   A = { a ∈ V_h : Λ_a − c_a W_a > 0 },   c_a = μ̄ ∫|∇φ_a|² / ∫φ_a
+   *
+   * (contact_stiffness()), where c_a has the units of Λ/W (μ̄ = μ1μ2/(μ1+μ2)
+   * is the tension of the obstacle problem for w = u1 − u2,
+   * DecoupledSystem).
+   *
+   * <b>Decisions relative to the data.</b> In the units of the data, the
+   * test reads λ̂_a − Ŵ_a > 0 with
+   *
+   *   λ̂_a = λ_a / (c_a U_∞),   Ŵ_a = W_a / U_∞,   U_∞ = max|U|,
+   *
+   * both unchanged when the loads and g are multiplied by a factor, or μ1
+   * and μ2 (with the loads) by a factor. (c_a U_∞ d_a = μ̄ ∫|∇φ_a|² U_∞ is
+   * the size of the forces of the obstacle problem for w at a.) After a
+   * solve, W_a = 0 on A and λ_a = 0 off A, up to round-off, so the test
+   * keeps an active vertex iff λ_a > 0 and activates an inactive one iff
+   * W_a < 0; c_a only matters for the initial active set of a mesh. Where
+   * both are zero in exact arithmetic (a degenerate vertex: the membranes
+   * touch without pressing on each other), the sign of the test is the
+   * sign of round-off, a vertex may flip at every iteration, and the plain
+   * method cycles. Each sign is therefore read with a band of indifference
+   * ε = `Tolerance`:
+   * - an active vertex is released iff λ̂_a < −ε,
+   * - an inactive vertex is activated iff Ŵ_a < −ε,
+   * - every other vertex keeps its status (hysteresis).
+   * The band is about that of the KKT residual: a vertex kept in it adds at
+   * most about ε to its dual (−λ_a d_a / F^w_∞, F^w_∞ ≥ μ̄ ∫|∇φ_a|² U_∞) or
+   * primal (−W_a / U_∞) feasibility part, so either status is an acceptable
+   * answer for it. λ_a is DiscreteAction::lambda(), the multiplier of the
+   * obstacle problem for w: its rounding and algebraic errors are those of
+   * forces of tension μ̄, as the band is, whatever the tension ratio.
+   *
+   * <b>The next active set, predicted.</b> Where strict complementarity
+   * fails at the free boundary (λ and u1 − u2 both vanish there, as in
+   * parameters/degenerate-free-boundary.prm), the discrete contact zone of
+   * a finer mesh reaches several layers of vertices beyond the one
+   * interpolated from the coarser mesh: with u1 − u2 ~ dist³, the O(h²)
+   * errors of the coarse solution move its edge by O(h^{2/3}), i.e. by
+   * O(h^{−1/3}) layers (benchmarks/README.md, "The prediction of the active
+   * set, before and after", measures it). The plain update then overshoots:
+   * the first solve penetrates over a band wider than the missing one, all
+   * of it is activated, and the surplus is released one layer per
+   * iteration, because only its outer rim feels the free vertices beyond
+   * (inside the band the load presses the membranes together, so λ_a > 0
+   * there): the number of iterations grows with refinement. So when the
+   * test wants changes, the next active set is the test applied not to the
+   * iterate itself but to a prediction from it: n_prediction_sweeps sweeps
+   * of projected Jacobi on the obstacle problem for w with s fixed,
+   *
+   *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
+   *
+   * ‖A_a‖₁ = Σ_b |A_ab| the l1 norm of the row of a in the condensed
+   * Laplacian (one product with the operator of DiscreteAction per sweep).
+   * Where A is an M-matrix, ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and
+   * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
+   * dominant, hence positive semidefinite, so the sweeps never increase
+   * the energy norm of the error, on any mesh. Plain Jacobi has no such
+   * guarantee where A is not an M-matrix (it diverges on the curved,
+   * locally refined cells of the disk), and l1-Jacobi (the divisor ‖A_a‖₁)
+   * takes half this step where A is an M-matrix, so its prediction lags
+   * (benchmarks/README.md compares both). Each sweep carries the contact
+   * information one layer further: penetrated vertices are clamped and
+   * lift their neighbours, active vertices pulled apart are released with
+   * the ones behind them. Where the predicted test is within the band of
+   * indifference, the prediction has nothing to say and the plain test on
+   * the iterate decides: a vertex that the solves keep penetrating by a
+   * few ε is clamped by the sweeps to a contact force within the band, and
+   * without the plain test it would stay inactive until the prediction
+   * wants no change at all (an extra iteration on the finest meshes of a
+   * degenerate free boundary). The prediction only proposes; the solve of
+   * the next iteration and the plain test decide, and convergence is
+   * judged on the iterate alone. If the prediction wants no change, or once a
+   * cycle has been detected on the mesh, the plain update is used, so that the
+   * remedy against cycling (ActiveSetHistory) works on the plain test.
+   *
+   * Each process holds the locally owned vertices of A (their DoFs);
+   * locally_relevant() tells every process the status of the vertices of
+   * its ghost cells, for the constraints of the cells it assembles.
+   */
+  template <int dim>
+  class ActiveSet
+  {
+  public:
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
+    using Vertex          = typename DiscreteProblem<dim>::Vertex;
+
+    ActiveSet(const Parameters::Solver  &parameters,
+              const Discretization<dim> &discretization,
+              const ProblemData<dim>    &data,
+              const MPI_Comm             mpi_communicator);
+
+    /** No active vertex on the mesh of @p discrete_problem (the first mesh). */
+    void
+    reinit(const DiscreteProblem<dim> &discrete_problem);
+
+    /**
+     * The active set {a : Λ_a − c_a W_a > 0} of a new mesh, for the previous
+     * mesh's solution (@p solution, the locally owned DoFs) and λ_h
+     * interpolated onto it (nested iteration). A
+     * vertex where both |λ̂_a| ≤ ε and |Ŵ_a| ≤ ε is degenerate up to
+     * round-off; it starts inactive, as every vertex of the first mesh does.
+     */
+    void
+    reinit(const DiscreteProblem<dim> &discrete_problem,
+           const BlockVectorType      &solution,
+           const VectorType           &ghosted_lambda_h);
+
+    /** Whether the locally owned vertex k of DiscreteProblem::vertices() is
+     * active. */
+    bool
+    is_active(const unsigned int k) const
+    {
+      return active_flags[k];
+    }
+
+    /** The locally owned active vertices (their DoFs). */
+    const IndexSet &
+    locally_owned() const;
+
+    /** The number of active vertices (all processes). */
+    types::global_dof_index
+    n_active_vertices() const;
+
+    /**
+     * The active vertices among the locally relevant ones of the mesh of
+     * @p problem, by a ghost
+     * exchange: the owner of each vertex decides, every process that shares
+     * a cell with it learns the decision. ActiveSetSystem::assemble()
+     * imposes them on the linear problem of an iteration: as constraint
+     * lines u1(a) = u2(a) in CoupledSystem, as the projection Π (and, in
+     * the matrix of W, constraint lines W_a = 0) in DecoupledSystem.
+     */
+    IndexSet
+    locally_relevant(const DiscreteProblem<dim> &problem) const;
+
+    /** c_a = μ̄ ∫|∇φ_a|² / d_a. */
+    double
+    contact_stiffness(const Vertex &a) const;
+
+    /**
+     * The KKT defects of the iterate @p solution (locally owned DoFs) with
+     * λ_a in @p action.
+     */
+    KKTDefects
+    kkt_defects(const DiscreteProblem<dim> &problem,
+                const DiscreteAction<dim>  &action,
+                const BlockVectorType      &solution) const;
+
+    /**
+     * The locally owned vertices whose status the test wants to change on
+     * the iterate @p solution (locally owned DoFs), with λ_a in @p action,
+     * outside the band of indifference, by increasing DoF.
+     */
+    std::vector<StatusChange>
+    wanted_changes(const DiscreteProblem<dim> &problem,
+                   const DiscreteAction<dim>  &action,
+                   const BlockVectorType      &solution) const;
+
+    /** Start the record of the sets visited on this mesh (ActiveSetHistory). */
+    void
+    restart();
+
+    /** What update() did. */
+    struct Update : ActiveSetHistory::Step
+    {
+      /**
+       * F_∞ and F^w_∞ (DiscreteAction) of the predicted iterate, if the
+       * update predicted one: the force scales that the next linear solve
+       * is measured against.
+       */
+      std::optional<std::array<double, 2>> predicted_force_scales;
+    };
+
+    /**
+     * Move to the next active set after the iterate @p solution (locally
+     * owned entries), whose plain test wants @p changes: the changes of the
+     * prediction, unless a cycle has been detected on this mesh or the
+     * prediction wants none (then @p changes); then the remedy against
+     * cycling, ActiveSetHistory::next().
+     */
+    Update
+    update(const DiscreteProblem<dim>      &problem,
+           const BlockVectorType           &solution,
+           const std::vector<StatusChange> &changes);
+
+  private:
+    /**
+     * Sweeps of projected Jacobi in predicted_changes(): more layers than
+     * the free boundary moves between two nested meshes, which grows like
+     * O(h^{−1/3}) at a degenerate free boundary (benchmarks/README.md, "The
+     * prediction of the active set, before and after", measures the layers
+     * and fewer sweeps).
+     */
+    static constexpr unsigned int n_prediction_sweeps = 40;
+
+    /**
+     * The locally owned vertices whose status the test wants to change on
+     * the iterate predicted from @p solution by n_prediction_sweeps sweeps
+     * of projected Jacobi; at the vertices where that test is within the
+     * band, those of @p plain_changes. Leaves the λ_a of the predicted iterate
+     * in `predicted_action`.
+     */
+    std::vector<StatusChange>
+    predicted_changes(const DiscreteProblem<dim>      &problem,
+                      const BlockVectorType           &solution,
+                      const std::vector<StatusChange> &plain_changes);
+
+    const Parameters::Solver &parameters;
+    const ProblemData<dim>   &data;
+
+    /**
+     * active_flags from active_vertices, in one pass over both and the
+     * vertices of @p problem.
+     */
+    void
+    set_flags(const DiscreteProblem<dim> &problem);
+
+    const MPI_Comm mpi_communicator;
+    /** The locally owned active vertices. */
+    IndexSet active_vertices;
+    /**
+     * The same as one flag per locally owned vertex of V_h, in the order of
+     * DiscreteProblem::vertices(): what the loops over the vertices read.
+     */
+    std::vector<char> active_flags;
+    /** The sets visited on this mesh. */
+    ActiveSetHistory history;
+    /** λ_a of the predicted iterate (not that of the iterate itself). */
+    DiscreteAction<dim> predicted_action;
+  };
+} // namespace membranes
+
+#endif

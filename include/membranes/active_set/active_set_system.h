@@ -1,0 +1,122 @@
+#ifndef membranes_active_set_system_h
+#define membranes_active_set_system_h
+
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/active_set/active_set_solver.h>
+#include <membranes/active_set/linear_solver.h>
+#include <membranes/mesh/discrete_problem.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/scene/parameters.h>
+#include <membranes/scene/problem_data.h>
+#include <string>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The linear problem of one iteration of the primal-dual active set
+   * method (ActiveSetSolver) for an active set A ⊂ V_h: find (u1h, u2h)
+   * with u1h = g_h, u2h = g2_h on ∂ω, the hanging node constraints,
+   *
+   *   W_a = u1h(a) − u2h(a) = 0  on A,     λ_a = 0  on V_h \ A,
+   *
+   * and on A the sum of the equations of the two membranes at a (λ_1a =
+   * λ_2a, the test function (φ_a, φ_a) of Prop. 12). Two ways to solve it
+   * give the same iterate: CoupledSystem on the pair (u1h, u2h), as step-41
+   * does it, and, for constant tensions, DecoupledSystem on
+   * s = μ1 u1h + μ2 u2h and w = u1h − u2h.
+   *
+   * What does not depend on the active set (the constraints of the mesh,
+   * the loads, and for the decoupled system the operator) is built once per
+   * mesh, in setup() or on the first iteration of a mesh; assemble() and
+   * solve() otherwise only do what the active set changes. ActiveSetSolver
+   * times the two in the sections "assembly" and "solve"; solve() adds its
+   * CG iterations to the ActiveSetStatistics it is given.
+   */
+  template <int dim>
+  class ActiveSetSystem
+  {
+  public:
+    using VectorType      = TrilinosWrappers::MPI::Vector;
+    using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
+
+    virtual ~ActiveSetSystem() = default;
+
+    /**
+     * Matrices, sparsity patterns and the constraints that do not depend on
+     * the active set, for the mesh of @p problem: @p dof_handler with its
+     * @p hanging_node_constraints.
+     */
+    virtual void
+    setup(const DiscreteProblem<dim>      &problem,
+          const DoFHandler<dim>           &dof_handler,
+          const AffineConstraints<double> &hanging_node_constraints) = 0;
+
+    /**
+     * What the linear problem on the mesh of @p problem and @p dof_handler
+     * for @p active_set (DoFs of the active
+     * locally relevant vertices, ActiveSet::locally_relevant(), so that
+     * every process knows the constraints of the cells it assembles) needs
+     * before its solve: here, not in solve(), the active set is imposed.
+     * CoupledSystem merges its contact lines u1(a) = u2(a) into
+     * AffineConstraints, sets them in @p solution, the initial guess, and
+     * assembles the condensed system; DecoupledSystem imposes W_a = 0 as
+     * the projection Π of the operator of W (its own vector W and the
+     * right-hand side zeroed at the active vertices), and condenses the
+     * lines W_a = 0 into the matrix of W only when the direct solver or the
+     * AMG setup needs that matrix.
+     */
+    virtual void
+    assemble(const DiscreteProblem<dim> &problem,
+             const DoFHandler<dim>      &dof_handler,
+             const IndexSet             &active_set,
+             BlockVectorType            &solution) = 0;
+
+    /**
+     * Solve the linear problem of the last assemble(), starting from
+     * @p solution, to the residual norms @p tolerances. On return
+     * @p solution holds (u1h, u2h), constraints included.
+     */
+    virtual void
+    solve(const DiscreteProblem<dim> &problem,
+          BlockVectorType            &solution,
+          const LinearTolerances     &tolerances,
+          ActiveSetStatistics        &statistics) = 0;
+
+    /**
+     * Free the matrices, vectors and the AMG hierarchy of this mesh once the
+     * active set method has finished on it, so that the postprocessing, the
+     * estimators and the refinement run without them; setup() makes them
+     * anew for the next mesh.
+     */
+    virtual void
+    clear() = 0;
+
+    /** The method and its linear solver, e.g. "coupled, direct". */
+    std::string
+    description() const;
+
+  protected:
+    ActiveSetSystem(const std::string         &method,
+                    const Parameters::Solver  &parameters,
+                    const Discretization<dim> &discretization,
+                    const ProblemData<dim>    &data,
+                    const MPI_Comm             mpi_communicator);
+
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
+    const MPI_Comm             mpi_communicator;
+    LinearSolver<dim>          linear_solver;
+
+  private:
+    const std::string method;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,268 @@
+#ifndef membranes_discrete_problem_h
+#define membranes_discrete_problem_h
+
+#include <array>
+#include <deal.II/base/function.h>
+#include <deal.II/base/index_set.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/mapping.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_parallel_block_vector.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/scene/problem_data.h>
+#include <utility>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * @p hanging_node_constraints (closed) of @p dof_handler and
+   * @p boundary_values, interpolated at its boundary DoFs on all of ∂ω with
+   * @p mapping, into @p constraints (closed): what is constrained on every
+   * iteration of a mesh. A hanging vertex on ∂ω keeps its hanging node
+   * constraint.
+   */
+  template <int dim>
+  void
+  make_mesh_constraints(
+    const Mapping<dim>              &mapping,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const Function<dim>             &boundary_values,
+    AffineConstraints<double>       &constraints);
+
+
+
+  /**
+   * The discrete problem (3.4) on one mesh without its contact condition:
+   * the Laplacian and the loads of the two membranes on the scalar P1/Q1
+   * space, and the dual cells of the interior vertices. It is built once per
+   * mesh (MembraneProblem::setup_system()) and read, through a const
+   * reference, by everything that works on the mesh: DiscreteAction (the
+   * postprocessing (4.5)), the linear systems of the active set method
+   * (CoupledSystem, DecoupledSystem) and the ActiveSet. It holds no
+   * reference to the DoFHandler it was built on; what needs one gets it
+   * from its owner, MembraneProblem.
+   *
+   * Both membranes live on one mesh with the same scalar element, so their
+   * Laplacians are one matrix A and the operator of membrane i is μ_i A.
+   * One DoFHandler of the scalar element numbers the vertices; membrane i
+   * is block i of the vectors of the mesh (Discretization), so a vertex has
+   * one DoF, the same in both blocks.
+   *
+   * It holds
+   * - A = (∫ ∇φ_a·∇φ_b), condensed by AffineConstraints with the hanging
+   *   node constraints and the boundary values: the rows and columns of
+   *   constrained DoFs eliminated, Σ_K A_K(j, j) on their diagonal. It is
+   *   the matrix of S in DecoupledSystem, whose solve_s() builds an AMG
+   *   hierarchy from it, the matrix CG applies to W through the projection
+   *   Π, and the operator of λ_a in DiscreteAction. The other hierarchy
+   *   of the decoupled method on a mesh is built from the condensed matrix
+   *   of W (μ̄ A with the rows and columns of the active vertices
+   *   eliminated; anew only when CG slows down), and CoupledSystem builds
+   *   one from its system matrix on every iteration;
+   * - the loads F_i = (∫ f_i φ_a), condensed with the hanging node
+   *   constraints, and the lifted loads F_i − μ_i A_{·,∂} g_i, condensed
+   *   like A with the boundary values g_1 = g, g_2 = g2: the right-hand
+   *   sides of membrane i. Their difference is the boundary column part of
+   *   μ_i A U_i, so that μ_i (A U_i)_a with the columns of ∂ω is
+   *   stiffness_term() without a second matrix;
+   * - the cell loads F_1K, F_2K (and the mean and oscillation of each load
+   *   on K) in the layout of CellSystem::copy_loads(), so that no system
+   *   evaluates the data again on this mesh;
+   * - the set V_h of the unconstrained interior vertices with, for each
+   *   locally owned one, d_a = ∫ φ_a (the lumped mass of (4.17); with
+   *   hanging nodes the row sum of the constrained mass matrix), ∫|∇φ_a|²
+   *   and the l1 norm of its row of A.
+   */
+  template <int dim>
+  class DiscreteProblem
+  {
+  public:
+    using VectorType = TrilinosWrappers::MPI::Vector;
+
+    /** One vertex a of V_h: its DoF and the data of its dual cell. */
+    struct Vertex
+    {
+      /** The DoF of a, the same in both blocks (u1h(a), u2h(a)). */
+      types::global_dof_index dof;
+      /** d_a = ∫ φ_a, the measure of D_a on triangles (4.17). */
+      double dual_cell_measure;
+      /**
+       * Σ_K A_K(a, a) = ∫ |∇φ_a|² for the hat function of a without the
+       * shares of the hanging vertices it constrains: the scale of the
+       * stiffness matrix at a.
+       */
+      double stiffness_diagonal;
+      /**
+       * Σ_b |A_ab|, the l1 norm of the row of a in A (condensed with the
+       * hanging node constraints and the boundary values): half of it is
+       * the divisor of the projected Jacobi sweeps of ActiveSet.
+       */
+      double stiffness_row_l1_norm;
+    };
+
+    DiscreteProblem(const Discretization<dim> &discretization,
+                    const ProblemData<dim>    &data);
+
+    /**
+     * Assemble A, the loads and d_a on the mesh of @p dof_handler, with its
+     * hanging node constraints @p hanging_node_constraints, and find V_h.
+     */
+    void
+    reinit(const DoFHandler<dim>           &dof_handler,
+           const AffineConstraints<double> &hanging_node_constraints,
+           const MPI_Comm                   mpi_communicator);
+
+    /**
+     * @p hanging_node_constraints of @p dof_handler and the boundary values
+     * c1 g + c2 g2 on all of ∂ω, into @p constraints (closed): those of u1
+     * (1, 0), u2 (0, 1) and of their combinations s and w.
+     */
+    void
+    make_constraints(const DoFHandler<dim>           &dof_handler,
+                     const AffineConstraints<double> &hanging_node_constraints,
+                     const double                     c1,
+                     const double                     c2,
+                     AffineConstraints<double>       &constraints) const;
+
+    MPI_Comm
+    get_mpi_communicator() const;
+    /**
+     * The index sets of the step-40 layout: the locally owned DoFs of the
+     * mesh, and those of the owned and ghost cells. Every block of a vector
+     * of the mesh has them.
+     */
+    const IndexSet &
+    locally_owned_dofs() const;
+    const IndexSet &
+    locally_relevant_dofs() const;
+
+    /** A, condensed with the hanging node constraints and boundary values. */
+    const TrilinosWrappers::SparseMatrix &
+    laplace_matrix() const;
+
+    /** F_i, condensed with the hanging node constraints. */
+    const VectorType &
+    loads(const unsigned int i) const;
+
+    /** F_i − μ_i A_{·,∂} g_i, condensed as A (zero in constrained rows). */
+    const VectorType &
+    lifted_loads(const unsigned int i) const;
+
+    /** The loads F_1K, F_2K of the locally owned cell @p cell. */
+    const double *
+    cell_loads(
+      const typename DoFHandler<dim>::active_cell_iterator &cell) const;
+
+    /**
+     * The mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of load @p i on
+     * the locally owned cell @p cell.
+     */
+    std::pair<double, double>
+    load_mean_and_oscillation(
+      const typename DoFHandler<dim>::active_cell_iterator &cell,
+      const unsigned int                                    i) const;
+
+    /** The locally owned vertices of V_h, by increasing DoF. */
+    const std::vector<Vertex> &
+    vertices() const;
+
+    /**
+     * W_a = u1h(a) − u2h(a) at the locally owned vertex k of vertices(),
+     * read from the local storage of the two blocks of @p solution at the
+     * position of the vertex: no search per entry.
+     */
+    double
+    nodal_w(const unsigned int                        k,
+            const TrilinosWrappers::MPI::BlockVector &solution) const
+    {
+      const unsigned int p = positions[k];
+      return solution.block(0).begin()[p] - solution.block(1).begin()[p];
+    }
+
+    /**
+     * The positions of the DoFs of vertices() in the local storage of a
+     * vector of the locally owned DoFs (every block of a vector of the mesh
+     * has that layout): reading them there needs no search per entry.
+     */
+    const std::vector<unsigned int> &
+    local_positions() const;
+
+    /**
+     * The DoFs of the locally relevant vertices of V_h: those of the
+     * locally owned and ghost cells.
+     */
+    const std::vector<types::global_dof_index> &
+    locally_relevant_vertices() const;
+
+    /**
+     * Whether the DoF @p a (locally relevant) belongs to an interior
+     * vertex, of V_h or hanging: the vertices whose dual cells make up ω_h.
+     */
+    bool
+    is_interior_vertex(const types::global_dof_index a) const;
+
+    /**
+     * The same for vertex @p v of the locally relevant @p cell, by the
+     * vertex's index in the mesh: no search (the loops over the cells).
+     */
+    bool
+    is_interior_vertex(
+      const typename DoFHandler<dim>::active_cell_iterator &cell,
+      const unsigned int                                    v) const
+    {
+      return interior_vertex_flags[cell->vertex_index(v)];
+    }
+
+  private:
+    /**
+     * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
+     * condensed by distribute_local_to_global with its constraints.
+     */
+    void
+    assemble(
+      const DoFHandler<dim>                          &dof_handler,
+      const AffineConstraints<double>                &hanging_node_constraints,
+      const std::array<AffineConstraints<double>, 2> &membrane_constraints,
+      VectorType                                     &dual_cell_measure,
+      VectorType                                     &stiffness_diagonal);
+
+    /** V_h and its data, from the vectors that assemble() fills. */
+    void
+    find_vertices(const DoFHandler<dim>           &dof_handler,
+                  const AffineConstraints<double> &hanging_node_constraints,
+                  const VectorType                &dual_cell_measure,
+                  const VectorType                &stiffness_diagonal);
+
+    const Discretization<dim> &discretization;
+    const ProblemData<dim>    &data;
+
+    MPI_Comm mpi_communicator;
+    IndexSet owned_dofs, relevant_dofs;
+
+    TrilinosWrappers::SparseMatrix matrix;
+    std::array<VectorType, 2>      load_vectors;
+    std::array<VectorType, 2>      lifted_load_vectors;
+    /**
+     * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
+     * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
+     * on (n_v hat functions per cell).
+     */
+    std::vector<double> loads_of_cells;
+    unsigned int        loads_per_cell;
+
+    std::vector<Vertex>                  interior_vertices;
+    std::vector<unsigned int>            positions;
+    std::vector<types::global_dof_index> relevant_vertices;
+    IndexSet                             interior_vertex_dofs;
+    /** is_interior_vertex() by the index of the vertex in the mesh. */
+    std::vector<char> interior_vertex_flags;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,310 @@
+#include <algorithm>
+#include <cmath>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/diagonal_matrix.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/linear_operator.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <membranes/active_set/coupled_system.h>
+#include <membranes/mesh/cell_system.h>
+
+namespace membranes
+{
+  template <int dim>
+  CoupledSystem<dim>::CoupledSystem(const Parameters::Solver  &parameters,
+                                    const Discretization<dim> &discretization,
+                                    const ProblemData<dim>    &data,
+                                    const MPI_Comm             mpi_communicator)
+    : ActiveSetSystem<dim>("coupled",
+                           parameters,
+                           discretization,
+                           data,
+                           mpi_communicator)
+  {}
+
+
+
+  template <int dim>
+  IndexSet
+  CoupledSystem<dim>::system_unknowns(const IndexSet &dofs) const
+  {
+    IndexSet unknowns(block_indices.total_size());
+    for (unsigned int i = 0; i < 2; ++i)
+      unknowns.add_indices(dofs, block_indices.block_start(i));
+    unknowns.compress();
+    return unknowns;
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::get_system_indices(
+    const std::vector<types::global_dof_index> &dofs,
+    std::vector<types::global_dof_index>       &indices) const
+  {
+    indices.resize(2 * dofs.size());
+    for (unsigned int i = 0; i < 2; ++i)
+      for (unsigned int v = 0; v < dofs.size(); ++v)
+        indices[i * dofs.size() + v] =
+          block_indices.local_to_global(i, dofs[v]);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::setup(
+    const DiscreteProblem<dim>      &problem,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints)
+  {
+    block_indices.reinit(2, dof_handler.n_dofs());
+    const IndexSet owned    = system_unknowns(problem.locally_owned_dofs());
+    const IndexSet relevant = system_unknowns(problem.locally_relevant_dofs());
+
+    // The constraints of membrane i (hanging nodes, boundary values g_i)
+    // on the unknowns of block i.
+    mesh_constraints.clear();
+    mesh_constraints.reinit(relevant);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        AffineConstraints<double> membrane_constraints;
+        problem.make_constraints(dof_handler,
+                                 hanging_node_constraints,
+                                 i == 0 ? 1 : 0,
+                                 i == 0 ? 0 : 1,
+                                 membrane_constraints);
+        for (const auto &line : membrane_constraints.get_lines())
+          {
+            const auto row = block_indices.local_to_global(i, line.index);
+            mesh_constraints.add_line(row);
+            for (const auto &[column, weight] : line.entries)
+              mesh_constraints.add_entry(
+                row, block_indices.local_to_global(i, column), weight);
+            mesh_constraints.set_inhomogeneity(row, line.inhomogeneity);
+          }
+      }
+    mesh_constraints.close();
+
+    // The constants of each membrane are the near null space of the system.
+    const unsigned int n_owned = problem.locally_owned_dofs().n_elements();
+    std::vector<std::vector<bool>> constant_modes(2,
+                                                  std::vector<bool>(2 * n_owned,
+                                                                    false));
+    for (unsigned int i = 0; i < 2; ++i)
+      std::fill_n(constant_modes[i].begin() + i * n_owned, n_owned, true);
+    this->linear_solver.reinit(block_indices.total_size(), constant_modes);
+
+    // The contact constraint u1(a) = u2(a) only ever couples unknowns of
+    // vertices that share a cell, so the full coupling of all unknowns of a
+    // cell (condensed with the constraints of the mesh) holds the matrix
+    // of every active set, as step-41's pattern holds that of every active
+    // set of its obstacle problem.
+    DynamicSparsityPattern               dsp(relevant);
+    std::vector<types::global_dof_index> dofs(
+      dof_handler.get_fe().n_dofs_per_cell());
+    std::vector<types::global_dof_index> indices;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(dofs);
+          get_system_indices(dofs, indices);
+          mesh_constraints.add_entries_local_to_global(indices, dsp, false);
+        }
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               owned,
+                                               this->mpi_communicator,
+                                               relevant);
+    system_matrix.reinit(owned, owned, dsp, this->mpi_communicator);
+    system_rhs.reinit(owned, this->mpi_communicator);
+    system_solution.reinit(owned, this->mpi_communicator);
+    // The tension μ_i of the membrane of each locally owned unknown: those
+    // of u1, then those of u2.
+    tension.reinit(owned, this->mpi_communicator);
+    std::fill_n(tension.begin(), n_owned, this->data.mu[0]);
+    std::fill_n(tension.begin() + n_owned, n_owned, this->data.mu[1]);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::copy_to_system(const BlockVectorType &solution)
+  {
+    // The local storage of system_solution holds the owned entries of u1,
+    // then those of u2.
+    const unsigned int n_owned = solution.block(0).locally_owned_size();
+    for (unsigned int i = 0; i < 2; ++i)
+      std::copy_n(solution.block(i).begin(),
+                  n_owned,
+                  system_solution.begin() + i * n_owned);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::copy_from_system(BlockVectorType &solution) const
+  {
+    const unsigned int n_owned = solution.block(0).locally_owned_size();
+    for (unsigned int i = 0; i < 2; ++i)
+      std::copy_n(system_solution.begin() + i * n_owned,
+                  n_owned,
+                  solution.block(i).begin());
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::assemble_system(const DiscreteProblem<dim> &problem,
+                                      const DoFHandler<dim>      &dof_handler)
+  {
+    CellSystem<dim>    cell_system(this->discretization, this->data);
+    const unsigned int n_vertices = cell_system.dof_indices.size();
+    FullMatrix<double> cell_matrix(2 * n_vertices);
+    Vector<double>     cell_rhs(2 * n_vertices);
+    std::vector<types::global_dof_index> indices;
+    system_matrix = 0;
+    system_rhs    = 0;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          // Block diagonal: μ_i A_K and F_iK on membrane i.
+          cell_system.reinit_operator(cell);
+          cell_system.set_loads(problem.cell_loads(cell));
+          for (unsigned int i = 0; i < 2; ++i)
+            for (unsigned int v = 0; v < n_vertices; ++v)
+              {
+                for (unsigned int w = 0; w < n_vertices; ++w)
+                  cell_matrix(i * n_vertices + v, i * n_vertices + w) =
+                    this->data.mu[i] * cell_system.laplace_matrix(v, w);
+                cell_rhs(i * n_vertices + v) = cell_system.loads[i](v);
+              }
+          get_system_indices(cell_system.dof_indices, indices);
+          constraints.distribute_local_to_global(
+            cell_matrix, cell_rhs, indices, system_matrix, system_rhs);
+        }
+    system_matrix.compress(VectorOperation::add);
+    system_rhs.compress(VectorOperation::add);
+  }
+
+
+
+  template <int dim>
+  typename CoupledSystem<dim>::VectorType
+  CoupledSystem<dim>::tension_scaling(const DiscreteProblem<dim> &problem,
+                                      const IndexSet &active_set) const
+  {
+    const double M       = this->data.mu[0] + this->data.mu[1];
+    VectorType   scaling = tension;
+    for (const auto dof : problem.locally_relevant_vertices())
+      if (active_set.is_element(dof) &&
+          problem.locally_owned_dofs().is_element(dof))
+        for (unsigned int i = 0; i < 2; ++i)
+          scaling[block_indices.local_to_global(i, dof)] = M;
+    for (auto &entry : scaling)
+      entry = 1 / std::sqrt(entry);
+    scaling.compress(VectorOperation::insert);
+    return scaling;
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
+                               const DoFHandler<dim>      &dof_handler,
+                               const IndexSet             &active_set,
+                               BlockVectorType            &solution)
+  {
+    constraints.clear();
+    constraints.reinit(mesh_constraints.get_local_lines());
+    for (const auto dof : problem.locally_relevant_vertices())
+      if (active_set.is_element(dof))
+        {
+          const auto u1 = block_indices.local_to_global(0, dof);
+          constraints.add_line(u1);
+          constraints.add_entry(u1, block_indices.local_to_global(1, dof), 1.0);
+        }
+    constraints.merge(mesh_constraints);
+    constraints.close();
+    copy_to_system(solution);
+    constraints.distribute(system_solution);
+    copy_from_system(solution);
+    assemble_system(problem, dof_handler);
+    scaling = tension_scaling(problem, active_set);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::solve(const DiscreteProblem<dim> &,
+                            BlockVectorType        &solution,
+                            const LinearTolerances &tolerances,
+                            ActiveSetStatistics    &statistics)
+  {
+    VectorType &x = system_solution;
+    copy_to_system(solution);
+    if (this->linear_solver.is_direct())
+      this->linear_solver.solve_direct(system_matrix, x, system_rhs);
+    else
+      {
+        // CG on the system scaled by D = diag(m_j^{-1/2}), m_j = μ_i for
+        // the DoFs of membrane i at inactive vertices and on ∂ω, μ1 + μ2
+        // for both DoFs of an active vertex: D K D y = D b, u = D y. Its
+        // residual D r then has the norm Σ_a (r_W,a² / μ̄ + r_S,a² /
+        // (μ1 + μ2)) (sums over active vertices only r_S), so one bound on
+        // it bounds r_S and r_W each on its own scale. D⁻¹ P D⁻¹, P the AMG
+        // hierarchy of K built on every iteration, preconditions it.
+        VectorType inverse_scaling(scaling);
+        for (auto &entry : inverse_scaling)
+          entry = 1 / entry;
+        VectorType rhs = system_rhs;
+        rhs.scale(scaling);
+        x.scale(inverse_scaling);
+        this->linear_solver.initialize_preconditioner(system_matrix);
+        const double tolerance =
+          std::min(tolerances.contact / std::sqrt(this->data.mu_bar),
+                   tolerances.sum /
+                     std::sqrt(this->data.mu[0] + this->data.mu[1]));
+        const DiagonalMatrix<VectorType> scale(scaling),
+          inverse_scale(inverse_scaling);
+        const auto K = linear_operator<VectorType>(system_matrix);
+        const auto D = linear_operator<VectorType>(system_matrix, scale);
+        const auto D_inverse =
+          linear_operator<VectorType>(system_matrix, inverse_scale);
+        const auto amg =
+          linear_operator<VectorType>(system_matrix,
+                                      this->linear_solver.preconditioner());
+        statistics.linear_iterations += this->linear_solver.solve_cg(
+          D * K * D, D_inverse * amg * D_inverse, x, rhs, tolerance);
+        this->linear_solver.clear();
+        x.scale(scaling);
+      }
+    constraints.distribute(x);
+    copy_from_system(solution);
+  }
+
+
+
+  template <int dim>
+  void
+  CoupledSystem<dim>::clear()
+  {
+    this->linear_solver.clear();
+    system_matrix.clear();
+    system_rhs.clear();
+    system_solution.clear();
+    tension.clear();
+    scaling.clear();
+    constraints.clear();
+    mesh_constraints.clear();
+  }
+
+
+
+  template class CoupledSystem<2>;
+} // namespace membranes

@@ -1,0 +1,391 @@
+#include <algorithm>
+#include <deal.II/base/function.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/numerics/vector_tools.h>
+#include <map>
+#include <membranes/mesh/cell_loop.h>
+#include <membranes/mesh/cell_system.h>
+#include <membranes/mesh/discrete_problem.h>
+
+namespace membranes
+{
+  template <int dim>
+  void
+  make_mesh_constraints(
+    const Mapping<dim>              &mapping,
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const Function<dim>             &boundary_values,
+    AffineConstraints<double>       &constraints)
+  {
+    constraints.clear();
+    constraints.reinit(hanging_node_constraints.get_local_lines());
+    std::map<types::boundary_id, const Function<dim> *> boundary_functions;
+    for (const auto id : dof_handler.get_triangulation().get_boundary_ids())
+      boundary_functions[id] = &boundary_values;
+    VectorTools::interpolate_boundary_values(mapping,
+                                             dof_handler,
+                                             boundary_functions,
+                                             constraints);
+    // A hanging vertex on ∂ω keeps its hanging node constraint, its value
+    // that of the boundary values of its parents.
+    constraints.merge(hanging_node_constraints,
+                      AffineConstraints<double>::right_object_wins);
+    constraints.close();
+  }
+
+
+
+  template <int dim>
+  DiscreteProblem<dim>::DiscreteProblem(
+    const Discretization<dim> &discretization,
+    const ProblemData<dim>    &data)
+    : discretization(discretization)
+    , data(data)
+    , mpi_communicator(MPI_COMM_SELF)
+    , loads_per_cell(0)
+  {}
+
+
+
+  template <int dim>
+  void
+  DiscreteProblem<dim>::reinit(
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const MPI_Comm                   mpi_communicator)
+  {
+    this->mpi_communicator = mpi_communicator;
+    owned_dofs             = dof_handler.locally_owned_dofs();
+    relevant_dofs          = hanging_node_constraints.get_local_lines();
+
+    // Hanging nodes and the boundary values g_1 = g, g_2 = g2 of each
+    // membrane. They constrain the same lines: one pattern, without the
+    // rows and columns of constrained DoFs.
+    std::array<AffineConstraints<double>, 2> membrane_constraints;
+    make_constraints(
+      dof_handler, hanging_node_constraints, 1, 0, membrane_constraints[0]);
+    make_constraints(
+      dof_handler, hanging_node_constraints, 0, 1, membrane_constraints[1]);
+    DynamicSparsityPattern dsp(relevant_dofs);
+    DoFTools::make_sparsity_pattern(dof_handler,
+                                    dsp,
+                                    membrane_constraints[0],
+                                    false);
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               owned_dofs,
+                                               mpi_communicator,
+                                               relevant_dofs);
+    matrix.reinit(owned_dofs, owned_dofs, dsp, mpi_communicator);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        load_vectors[i].reinit(owned_dofs, mpi_communicator);
+        lifted_load_vectors[i].reinit(owned_dofs, mpi_communicator);
+      }
+
+    VectorType dual_cell_measure(owned_dofs, mpi_communicator);
+    VectorType stiffness_diagonal(owned_dofs, mpi_communicator);
+    assemble(dof_handler,
+             hanging_node_constraints,
+             membrane_constraints,
+             dual_cell_measure,
+             stiffness_diagonal);
+    find_vertices(dof_handler,
+                  hanging_node_constraints,
+                  dual_cell_measure,
+                  stiffness_diagonal);
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteProblem<dim>::make_constraints(
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const double                     c1,
+    const double                     c2,
+    AffineConstraints<double>       &constraints) const
+  {
+    const ScalarFunctionFromFunctionObject<dim> boundary_values(
+      [this, c1, c2](const Point<dim> &p) {
+        return c1 * data.boundary_values().value(p, 0) +
+               c2 * data.boundary_values().value(p, 1);
+      });
+    make_mesh_constraints(*discretization.mapping,
+                          dof_handler,
+                          hanging_node_constraints,
+                          boundary_values,
+                          constraints);
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteProblem<dim>::assemble(
+    const DoFHandler<dim>                          &dof_handler,
+    const AffineConstraints<double>                &hanging_node_constraints,
+    const std::array<AffineConstraints<double>, 2> &membrane_constraints,
+    VectorType                                     &dual_cell_measure,
+    VectorType                                     &stiffness_diagonal)
+  {
+    // The cell loop on threads: each works with its own CellSystem, the
+    // loads of every cell go to that cell's own slot of loads_of_cells, and
+    // the copier adds the cell's contributions to the global objects, as
+    // step-41 does, by distribute_local_to_global: A_K condensed with the
+    // constraints of the mesh, the loads F_iK with the hanging node
+    // constraints alone and, lifted by μ_i A_K, with the boundary values of
+    // membrane i, d_a = ∫ φ_a as the row sums of the mass matrix, and the
+    // diagonal ∫ |∇φ_a|².
+    struct CellContribution
+    {
+      FullMatrix<double>                   laplace_matrix;
+      std::array<Vector<double>, 2>        loads;
+      Vector<double>                       lumped_mass, diagonal;
+      std::vector<types::global_dof_index> dof_indices;
+    };
+    const unsigned int n_vertices = dof_handler.get_fe().n_dofs_per_cell();
+    loads_per_cell = CellSystem<dim>(discretization, data).n_load_entries();
+    loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
+                            loads_per_cell,
+                          0.);
+    FullMatrix<double> membrane_matrix(n_vertices);
+    run_on_cells<CellContribution>(
+      dof_handler,
+      [&]() { return std::make_unique<CellSystem<dim>>(discretization, data); },
+      [&](const auto       &cell,
+          CellSystem<dim>  &cell_system,
+          CellContribution &contribution) {
+        contribution.dof_indices.clear();
+        if (!cell->is_locally_owned())
+          return;
+        cell_system.reinit(cell);
+        cell_system.copy_loads(
+          &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
+        contribution.laplace_matrix = cell_system.laplace_matrix;
+        contribution.loads          = cell_system.loads;
+        contribution.lumped_mass    = cell_system.lumped_mass;
+        contribution.dof_indices    = cell_system.dof_indices;
+        contribution.diagonal.reinit(n_vertices);
+        for (unsigned int v = 0; v < n_vertices; ++v)
+          contribution.diagonal(v) = cell_system.laplace_matrix(v, v);
+      },
+      [&](const CellContribution &contribution) {
+        if (contribution.dof_indices.empty())
+          return;
+        const auto &dofs = contribution.dof_indices;
+        membrane_constraints[0].distribute_local_to_global(
+          contribution.laplace_matrix, dofs, matrix);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            hanging_node_constraints.distribute_local_to_global(
+              contribution.loads[i], dofs, load_vectors[i]);
+            membrane_matrix.equ(data.mu[i], contribution.laplace_matrix);
+            membrane_constraints[i].distribute_local_to_global(
+              contribution.loads[i],
+              dofs,
+              lifted_load_vectors[i],
+              membrane_matrix);
+          }
+        hanging_node_constraints.distribute_local_to_global(
+          contribution.lumped_mass, dofs, dual_cell_measure);
+        stiffness_diagonal.add(dofs, contribution.diagonal);
+      });
+    matrix.compress(VectorOperation::add);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        load_vectors[i].compress(VectorOperation::add);
+        lifted_load_vectors[i].compress(VectorOperation::add);
+      }
+    dual_cell_measure.compress(VectorOperation::add);
+    stiffness_diagonal.compress(VectorOperation::add);
+  }
+
+
+
+  template <int dim>
+  void
+  DiscreteProblem<dim>::find_vertices(
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    const VectorType                &dual_cell_measure,
+    const VectorType                &stiffness_diagonal)
+  {
+    // The interior vertices of the owned and ghost cells, each once (by
+    // its index in the mesh), by their DoFs.
+    const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
+    const auto    &triangulation = dof_handler.get_triangulation();
+    std::vector<char> seen(triangulation.n_vertices(), false);
+    interior_vertex_flags.assign(triangulation.n_vertices(), false);
+    std::vector<types::global_dof_index> candidates;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (!cell->is_artificial())
+        for (const unsigned int v : cell->vertex_indices())
+          if (!seen[cell->vertex_index(v)])
+            {
+              seen[cell->vertex_index(v)] = true;
+              if (boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
+                continue;
+              interior_vertex_flags[cell->vertex_index(v)] = true;
+              candidates.push_back(cell->vertex_dof_index(v, 0));
+            }
+    std::sort(candidates.begin(), candidates.end());
+
+    // The l1 norms of the locally owned rows of A, by Epetra's own row sums
+    // of absolute values (deal.II's row iterator of a Trilinos matrix
+    // resizes its row buffer to n() entries on every row it visits, which
+    // makes a pass over all rows quadratic in the number of DoFs).
+    VectorType row_l1_norm(owned_dofs, mpi_communicator);
+    AssertThrow(matrix.trilinos_matrix().InvRowSums(
+                  *row_l1_norm.trilinos_vector()(0)) == 0,
+                ExcInternalError());
+
+    // V_h: the unconstrained ones; its owned vertices carry λ_a.
+    interior_vertices.clear();
+    relevant_vertices.clear();
+    interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
+    for (const auto dof : candidates)
+      {
+        interior_vertex_dofs.add_index(dof);
+        if (hanging_node_constraints.is_constrained(dof))
+          continue;
+        relevant_vertices.push_back(dof);
+        if (owned_dofs.is_element(dof))
+          interior_vertices.push_back({dof,
+                                       dual_cell_measure[dof],
+                                       stiffness_diagonal[dof],
+                                       1 / row_l1_norm[dof]});
+      }
+    interior_vertex_dofs.compress();
+    positions.resize(interior_vertices.size());
+    for (unsigned int k = 0; k < interior_vertices.size(); ++k)
+      positions[k] = owned_dofs.index_within_set(interior_vertices[k].dof);
+  }
+
+
+
+  template <int dim>
+  MPI_Comm
+  DiscreteProblem<dim>::get_mpi_communicator() const
+  {
+    return mpi_communicator;
+  }
+
+
+
+  template <int dim>
+  const IndexSet &
+  DiscreteProblem<dim>::locally_owned_dofs() const
+  {
+    return owned_dofs;
+  }
+
+
+
+  template <int dim>
+  const IndexSet &
+  DiscreteProblem<dim>::locally_relevant_dofs() const
+  {
+    return relevant_dofs;
+  }
+
+
+
+  template <int dim>
+  const TrilinosWrappers::SparseMatrix &
+  DiscreteProblem<dim>::laplace_matrix() const
+  {
+    return matrix;
+  }
+
+
+
+  template <int dim>
+  const typename DiscreteProblem<dim>::VectorType &
+  DiscreteProblem<dim>::loads(const unsigned int i) const
+  {
+    return load_vectors[i];
+  }
+
+
+
+  template <int dim>
+  const typename DiscreteProblem<dim>::VectorType &
+  DiscreteProblem<dim>::lifted_loads(const unsigned int i) const
+  {
+    return lifted_load_vectors[i];
+  }
+
+
+
+  template <int dim>
+  const double *
+  DiscreteProblem<dim>::cell_loads(
+    const typename DoFHandler<dim>::active_cell_iterator &cell) const
+  {
+    return &loads_of_cells[cell->active_cell_index() * loads_per_cell];
+  }
+
+
+
+  template <int dim>
+  std::pair<double, double>
+  DiscreteProblem<dim>::load_mean_and_oscillation(
+    const typename DoFHandler<dim>::active_cell_iterator &cell,
+    const unsigned int                                    i) const
+  {
+    const double *statistics =
+      cell_loads(cell) + loads_per_cell - 4; // f̄_1K, f̄_2K, osc_1K, osc_2K
+    return {statistics[i], statistics[2 + i]};
+  }
+
+
+
+  template <int dim>
+  const std::vector<typename DiscreteProblem<dim>::Vertex> &
+  DiscreteProblem<dim>::vertices() const
+  {
+    return interior_vertices;
+  }
+
+
+
+  template <int dim>
+  const std::vector<unsigned int> &
+  DiscreteProblem<dim>::local_positions() const
+  {
+    return positions;
+  }
+
+
+
+  template <int dim>
+  const std::vector<types::global_dof_index> &
+  DiscreteProblem<dim>::locally_relevant_vertices() const
+  {
+    return relevant_vertices;
+  }
+
+
+
+  template <int dim>
+  bool
+  DiscreteProblem<dim>::is_interior_vertex(
+    const types::global_dof_index a) const
+  {
+    return interior_vertex_dofs.is_element(a);
+  }
+
+
+
+  template void
+  make_mesh_constraints(const Mapping<2> &,
+                        const DoFHandler<2> &,
+                        const AffineConstraints<double> &,
+                        const Function<2> &,
+                        AffineConstraints<double> &);
+  template class DiscreteProblem<2>;
+} // namespace membranes

@@ -1,0 +1,227 @@
+#include <algorithm>
+#include <iomanip>
+#include <membranes/output/atomic_file.h>
+#include <membranes/output/report.h>
+#include <set>
+#include <sstream>
+
+namespace membranes
+{
+  namespace
+  {
+    /**
+     * One field of a row of report.csv: the column name, the value (empty
+     * when the run does not compute it), and whether it counts something
+     * (a whole number).
+     */
+    struct Field
+    {
+      std::string           name;
+      std::optional<double> value;
+      bool                  count = false;
+    };
+
+    /** The row of one cycle, its fields in the order of the columns. */
+    std::vector<Field>
+    row(const CycleRecord &r)
+    {
+      const bool count = true;
+      // A member of an optional record: empty where the record is.
+      const auto error = [&r](const double ErrorRecord::*norm) {
+        return r.errors ? std::optional<double>((*r.errors).*norm) :
+                          std::nullopt;
+      };
+      const auto flux = [&r](const double FluxRecord::*part) {
+        return r.flux ? std::optional<double>((*r.flux).*part) : std::nullopt;
+      };
+      const auto flux_defect =
+        [&r](const std::optional<double> FluxRecord::*defect) {
+          return r.flux ? (*r.flux).*defect : std::nullopt;
+        };
+      const auto effectivity = [&r](const std::optional<double> &estimator) {
+        return estimator && r.errors ?
+                 std::optional<double>(*estimator / r.errors->energy) :
+                 std::nullopt;
+      };
+      const std::optional<double> flux_estimator = flux(&FluxRecord::estimator);
+      const SolveRecord          &solve          = r.solve;
+      const IdentityRecord       &identities     = r.identities;
+      const TimeRecord           &times          = r.times;
+      return {
+        {"cycle", r.mesh.cycle, count},
+        {"cells", r.mesh.cells, count},
+        {"dofs", static_cast<double>(r.mesh.dofs), count},
+        {"active_set_iterations", solve.active_set_iterations, count},
+        {"active_vertices", solve.active_vertices, count},
+        {"wall_time_s", times.method()},
+        {"cumulative_wall_time_s", r.cumulative_wall_time},
+        {"err_u1_H1", error(&ErrorRecord::u1_H1)},
+        {"err_u2_H1", error(&ErrorRecord::u2_H1)},
+        {"err_u1_L2", error(&ErrorRecord::u1_L2)},
+        {"err_u2_L2", error(&ErrorRecord::u2_L2)},
+        {"err_lambda_L2", error(&ErrorRecord::lambda_L2)},
+        {"estimator", r.estimator},
+        {"effectivity", effectivity(r.estimator)},
+        {"kkt_residual", solve.kkt_residual},
+        {"min_w", identities.min_w},
+        {"min_lambda", identities.min_lambda},
+        {"prop12_defect", identities.prop12_defect},
+        {"complementarity_defect", identities.complementarity_defect},
+        {"linear_iterations", solve.linear_iterations, count},
+        {"time_setup_s", times.setup},
+        {"time_assembly_s", times.assembly},
+        {"time_solve_s", times.solve},
+        {"time_postprocess_s", times.postprocess},
+        {"err_energy", error(&ErrorRecord::energy)},
+        {"time_estimate_s", times.estimate},
+        {"hanging_active_vertices", identities.hanging_active_vertices, count},
+        {"flux_estimator", flux_estimator},
+        {"flux_effectivity", effectivity(flux_estimator)},
+        {"measure_defect", flux_defect(&FluxRecord::measure_defect)},
+        {"conservation_defect", flux_defect(&FluxRecord::conservation_defect)},
+        {"balance_defect", flux_defect(&FluxRecord::balance_defect)},
+        {"time_flux_s", times.flux},
+        {"levels", r.mesh.levels, count},
+        {"processes", r.processes, count},
+        {"memory_mb", r.memory_mb},
+        {"eta_linearization", solve.linearization_estimate},
+        {"eta_algebraic", solve.algebraic_estimate},
+        {"flux_estimator_flux", flux(&FluxRecord::flux)},
+        {"flux_estimator_oscillation", flux(&FluxRecord::oscillation)},
+        {"flux_estimator_contact", flux(&FluxRecord::contact)},
+        {"flux_estimator_boundary", flux(&FluxRecord::boundary)},
+        {"time_errors_s", times.errors},
+        {"err_lambda_L2_omega_h", error(&ErrorRecord::lambda_L2_omega_h)}};
+    }
+  } // namespace
+
+
+
+  const std::vector<std::string> &
+  Report::column_names()
+  {
+    static const std::vector<std::string> names = [] {
+      std::vector<std::string> names;
+      for (const Field &field : row(CycleRecord()))
+        names.push_back(field.name);
+      return names;
+    }();
+    return names;
+  }
+
+
+
+  Report::Report(const Parameters::Output &parameters,
+                 const ConditionalOStream &pcout)
+    : parameters(parameters)
+    , pcout(pcout)
+  {}
+
+
+
+  void
+  Report::add(const CycleRecord &record)
+  {
+    records.push_back(record);
+    if (parameters.report && pcout.is_active())
+      write_csv();
+  }
+
+
+
+  void
+  Report::write_csv() const
+  {
+    write_atomically(parameters.directory + "/report.csv",
+                     [this](std::ostream &out) {
+                       const auto &names = column_names();
+                       for (unsigned int c = 0; c < names.size(); ++c)
+                         out << (c == 0 ? "" : ",") << names[c];
+                       out << '\n' << std::setprecision(12);
+                       for (const CycleRecord &record : records)
+                         {
+                           const auto fields = row(record);
+                           for (unsigned int c = 0; c < fields.size(); ++c)
+                             {
+                               if (c > 0)
+                                 out << ',';
+                               if (fields[c].value)
+                                 out << *fields[c].value;
+                             }
+                           out << '\n';
+                         }
+                     });
+  }
+
+
+
+  void
+  Report::print_convergence_table(const bool rates_in_dofs)
+  {
+    ConvergenceTable               table;
+    const std::vector<std::string> shown{"cycle",
+                                         "cells",
+                                         "dofs",
+                                         "active_set_iterations",
+                                         "active_vertices",
+                                         "cumulative_wall_time_s",
+                                         "err_u1_H1",
+                                         "err_u2_H1",
+                                         "err_u1_L2",
+                                         "err_u2_L2",
+                                         "err_lambda_L2",
+                                         "err_energy",
+                                         "estimator",
+                                         "effectivity",
+                                         "flux_estimator",
+                                         "flux_effectivity"};
+    // The columns that have values: the table knows no others (an
+    // adaptive run without exact solution has an estimator, but no
+    // effectivity).
+    std::set<std::string> filled;
+    for (const CycleRecord &record : records)
+      for (const Field &field : row(record))
+        if (std::find(shown.begin(), shown.end(), field.name) != shown.end() &&
+            field.value)
+          {
+            if (field.count)
+              table.add_value(field.name,
+                              static_cast<unsigned long long>(*field.value));
+            else
+              table.add_value(field.name, *field.value);
+            filled.insert(field.name);
+          }
+    for (const std::string &column : shown)
+      if (filled.count(column) != 0 &&
+          (column.rfind("err_", 0) == 0 ||
+           column.find("estimator") != std::string::npos ||
+           column.find("effectivity") != std::string::npos))
+        {
+          table.set_precision(column, 3);
+          table.set_scientific(column, true);
+          if (column.rfind("err_", 0) == 0)
+            table.evaluate_convergence_rates(
+              column,
+              "dofs",
+              ConvergenceTable::reduction_rate_log2,
+              rates_in_dofs ? 1 : 2);
+        }
+    table.set_precision("cumulative_wall_time_s", 2);
+    const bool with_rates =
+      std::any_of(filled.begin(), filled.end(), [](const std::string &c) {
+        return c.rfind("err_", 0) == 0;
+      });
+    if (pcout.is_active())
+      {
+        pcout << std::endl;
+        if (with_rates)
+          pcout << (rates_in_dofs ?
+                      "Observed rates (red.rate.log2) in DoFs: e ~ N^-rate" :
+                      "Observed rates (red.rate.log2) in h: e ~ h^rate, "
+                      "h ~ N^-1/2")
+                << std::endl;
+        table.write_text(pcout.get_stream(),
+                         TableHandler::TextOutputFormat::org_mode_table);
+      }
+  }
+} // namespace membranes
