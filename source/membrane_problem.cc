@@ -26,7 +26,7 @@ namespace membranes
                                             mpi_communicator))
     , dof_handler(*triangulation)
     , discrete_problem(discretization, data)
-    , active_set(parameters.solver, discretization, data, mpi_communicator)
+    , active_set(parameters.solver, data, mpi_communicator)
     , action(discretization, data)
     , active_set_solver(parameters.solver,
                         discretization,

@@ -225,7 +225,7 @@ namespace
       , dof_handler(*triangulation)
       , discrete_problem(discretization, data)
       , action(discretization, data)
-      , active_set(parameters.solver, discretization, data, mpi_communicator)
+      , active_set(parameters.solver, data, mpi_communicator)
       , solver(parameters.solver,
                discretization,
                data,

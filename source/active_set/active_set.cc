@@ -154,15 +154,13 @@ namespace membranes
 
 
   template <int dim>
-  ActiveSet<dim>::ActiveSet(const Parameters::Solver  &parameters,
-                            const Discretization<dim> &discretization,
-                            const ProblemData<dim>    &data,
-                            const MPI_Comm             mpi_communicator)
+  ActiveSet<dim>::ActiveSet(const Parameters::Solver &parameters,
+                            const ProblemData<dim>   &data,
+                            const MPI_Comm            mpi_communicator)
     : parameters(parameters)
     , data(data)
     , mpi_communicator(mpi_communicator)
     , history(mpi_communicator)
-    , predicted_action(discretization, data)
   {}
 
 
@@ -173,7 +171,6 @@ namespace membranes
   {
     active_vertices = IndexSet(discrete_problem.locally_owned_dofs().size());
     active_flags.assign(discrete_problem.vertices().size(), false);
-    predicted_action.reinit(discrete_problem);
   }
 
 
@@ -351,115 +348,23 @@ namespace membranes
 
 
   template <int dim>
-  typename ActiveSet<dim>::Update
+  ActiveSetHistory::Step
   ActiveSet<dim>::update(const DiscreteProblem<dim>      &problem,
-                         const BlockVectorType           &solution,
                          const std::vector<StatusChange> &changes)
   {
-    Update                           update;
-    const std::vector<StatusChange> *next = &changes;
-    std::vector<StatusChange>        predicted;
-    if (history.cycles() == 0)
-      {
-        predicted = predicted_changes(problem, solution, changes);
-        update.predicted_force_scales =
-          std::array<double, 2>{{predicted_action.force_scale(),
-                                 predicted_action.contact_force_scale()}};
-        if (Utilities::MPI::sum(predicted.size(), mpi_communicator) > 0)
-          next = &predicted;
-      }
-    static_cast<ActiveSetHistory::Step &>(update) =
-      history.next(active_vertices, *next);
-    active_vertices = update.active_set;
+    const ActiveSetHistory::Step step = history.next(active_vertices, changes);
+    active_vertices                   = step.active_set;
     set_flags(problem);
-    return update;
+    return step;
   }
 
 
 
   template <int dim>
-  std::vector<StatusChange>
-  ActiveSet<dim>::predicted_changes(
-    const DiscreteProblem<dim>      &problem,
-    const BlockVectorType           &solution,
-    const std::vector<StatusChange> &plain_changes)
+  unsigned int
+  ActiveSet<dim>::cycles() const
   {
-    const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
-    const double epsilon   = parameters.tolerance;
-    const double u_scale   = displacement_scale(solution);
-    const auto  &vertices  = problem.vertices();
-    const auto  &positions = problem.local_positions();
-
-    // Projected Jacobi on W with S = μ1 U1 + μ2 U2 fixed: W_a moves to
-    // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
-    // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
-    // condensed Laplacian. With S fixed, r_a = μ̄ (A W)_a − b_a, b the
-    // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem): one product
-    // with A on the scalar W per sweep, on contiguous local arrays. In the
-    // end U1 moves by μ2/M and U2 by −μ1/M of the change of W.
-    const double *const lifted_1 = problem.lifted_loads(0).begin();
-    const double *const lifted_2 = problem.lifted_loads(1).begin();
-    BlockVectorType     iterate  = solution;
-    VectorType          w        = iterate.block(0);
-    w -= iterate.block(1);
-    VectorType          stiffness_w(w);
-    double *const       w_values = w.begin();
-    const VectorType    start_w(w);
-    std::vector<double> load(vertices.size()),
-      inverse_diagonal(vertices.size());
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const unsigned int p = positions[k];
-        load[k]              = (mu2 * lifted_1[p] - mu1 * lifted_2[p]) / M;
-        inverse_diagonal[k] =
-          2 / (data.mu_bar * vertices[k].stiffness_row_l1_norm);
-      }
-    const double *const product = stiffness_w.begin();
-    for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
-      {
-        problem.laplace_matrix().vmult(stiffness_w, w);
-        for (unsigned int k = 0; k < vertices.size(); ++k)
-          {
-            const unsigned int p = positions[k];
-            const double       r = data.mu_bar * product[p] - load[k];
-            w_values[p] = std::max(0., w_values[p] - r * inverse_diagonal[k]);
-          }
-      }
-    VectorType &step = w;
-    step -= start_w;
-    iterate.block(0).add(mu2 / M, step);
-    iterate.block(1).add(-mu1 / M, step);
-    predicted_action.compute(iterate);
-
-    // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
-    // indifference; the plain test where the predicted one is in the band.
-    std::vector<StatusChange> changes;
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const auto  &a = vertices[k];
-        const double c = contact_stiffness(a);
-        const double test =
-          (predicted_action.lambda(k) - c * problem.nodal_w(k, iterate)) /
-          (c * u_scale);
-        const double violation = is_active(k) ? -test : test;
-        if (violation > epsilon)
-          changes.push_back({a.dof, violation / epsilon});
-        else if (std::abs(test) <= epsilon)
-          {
-            // The prediction is indifferent here: the plain test decides.
-            const auto plain =
-              std::lower_bound(plain_changes.begin(),
-                               plain_changes.end(),
-                               a.dof,
-                               [](const StatusChange           &change,
-                                  const types::global_dof_index dof) {
-                                 return change.dof < dof;
-                               });
-            if (plain != plain_changes.end() && plain->dof == a.dof)
-              changes.push_back(*plain);
-          }
-      }
-    return changes;
+    return history.cycles();
   }
 
 

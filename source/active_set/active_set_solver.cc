@@ -66,6 +66,7 @@ namespace membranes
     , pcout(pcout)
     , timer(timer)
     , mpi_communicator(mpi_communicator)
+    , prediction(parameters, discretization, data)
     , system(make_active_set_system(parameters,
                                     discretization,
                                     data,
@@ -86,6 +87,7 @@ namespace membranes
     const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints)
   {
+    prediction.reinit(discrete_problem);
     system->setup(discrete_problem, dof_handler, hanging_node_constraints);
 
     // The constants of balanced stopping: C_F of the bounding box of the
@@ -260,9 +262,20 @@ namespace membranes
                                const VectorType                &solution,
                                const std::vector<StatusChange> &changes,
                                const unsigned int               iteration,
-                               StoppingState                   &stopping) const
+                               StoppingState                   &stopping)
   {
-    const auto update = active_set.update(problem, solution, changes);
+    // The changes that the test wants on the predicted iterate, unless a
+    // cycle has been detected on this mesh or the prediction wants none.
+    const std::vector<StatusChange> *next = &changes;
+    std::vector<StatusChange>        predicted;
+    if (active_set.cycles() == 0)
+      {
+        predicted = prediction.changes(problem, active_set, solution, changes);
+        stopping.force_scales = prediction.force_scales();
+        if (Utilities::MPI::sum(predicted.size(), mpi_communicator) > 0)
+          next = &predicted;
+      }
+    const auto update = active_set.update(problem, *next);
     if (update.cycle_to)
       pcout << "      cycle: iteration " << iteration + 1
             << " would repeat the active set of iteration "
@@ -272,8 +285,6 @@ namespace membranes
                   " (Murty's least-index rule from now on)" :
                   " (the largest violations)")
             << std::endl;
-    if (update.predicted_force_scales)
-      stopping.force_scales = *update.predicted_force_scales;
   }
 
 

@@ -216,48 +216,10 @@ namespace membranes
    * obstacle problem for w: its rounding and algebraic errors are those of
    * forces of tension μ̄, as the band is, whatever the tension ratio.
    *
-   * <b>The next active set, predicted.</b> Where strict complementarity
-   * fails at the free boundary (λ and u1 − u2 both vanish there, as in
-   * parameters/degenerate-free-boundary.prm), the discrete contact zone of
-   * a finer mesh reaches several layers of vertices beyond the one
-   * interpolated from the coarser mesh: with u1 − u2 ~ dist³, the O(h²)
-   * errors of the coarse solution move its edge by O(h^{2/3}), i.e. by
-   * O(h^{−1/3}) layers (benchmarks/README.md, "The prediction of the active
-   * set, before and after", measures it). The plain update then overshoots:
-   * the first solve penetrates over a band wider than the missing one, all
-   * of it is activated, and the surplus is released one layer per
-   * iteration, because only its outer rim feels the free vertices beyond
-   * (inside the band the load presses the membranes together, so λ_a > 0
-   * there): the number of iterations grows with refinement. So when the
-   * test wants changes, the next active set is the test applied not to the
-   * iterate itself but to a prediction from it: n_prediction_sweeps sweeps
-   * of projected Jacobi on the obstacle problem for w with s fixed,
-   *
-   *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
-   *
-   * ‖A_a‖₁ = Σ_b |A_ab| the l1 norm of the row of a in the condensed
-   * Laplacian (one product with the operator of DiscreteAction per sweep).
-   * Where A is an M-matrix, ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and
-   * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
-   * dominant, hence positive semidefinite, so the sweeps never increase
-   * the energy norm of the error, on any mesh. Plain Jacobi has no such
-   * guarantee where A is not an M-matrix (it diverges on the curved,
-   * locally refined cells of the disk), and l1-Jacobi (the divisor ‖A_a‖₁)
-   * takes half this step where A is an M-matrix, so its prediction lags
-   * (benchmarks/README.md compares both). Each sweep carries the contact
-   * information one layer further: penetrated vertices are clamped and
-   * lift their neighbours, active vertices pulled apart are released with
-   * the ones behind them. Where the predicted test is within the band of
-   * indifference, the prediction has nothing to say and the plain test on
-   * the iterate decides: a vertex that the solves keep penetrating by a
-   * few ε is clamped by the sweeps to a contact force within the band, and
-   * without the plain test it would stay inactive until the prediction
-   * wants no change at all (an extra iteration on the finest meshes of a
-   * degenerate free boundary). The prediction only proposes; the solve of
-   * the next iteration and the plain test decide, and convergence is
-   * judged on the iterate alone. If the prediction wants no change, or once a
-   * cycle has been detected on the mesh, the plain update is used, so that the
-   * remedy against cycling (ActiveSetHistory) works on the plain test.
+   * When the test wants changes, ActiveSetSolver may move to the changes
+   * that the test wants on a predicted iterate instead
+   * (ActiveSetPrediction); update() takes whichever it is given, through
+   * the remedy against cycling (ActiveSetHistory).
    *
    * Each process holds the locally owned vertices of A (their DoFs);
    * locally_relevant() tells every process the status of the vertices of
@@ -271,10 +233,9 @@ namespace membranes
     using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
     using Vertex          = typename DiscreteProblem<dim>::Vertex;
 
-    ActiveSet(const Parameters::Solver  &parameters,
-              const Discretization<dim> &discretization,
-              const ProblemData<dim>    &data,
-              const MPI_Comm             mpi_communicator);
+    ActiveSet(const Parameters::Solver &parameters,
+              const ProblemData<dim>   &data,
+              const MPI_Comm            mpi_communicator);
 
     /** No active vertex on the mesh of @p discrete_problem (the first mesh). */
     void
@@ -347,51 +308,20 @@ namespace membranes
     void
     restart();
 
-    /** What update() did. */
-    struct Update : ActiveSetHistory::Step
-    {
-      /**
-       * F_∞ and F^w_∞ (DiscreteAction) of the predicted iterate, if the
-       * update predicted one: the force scales that the next linear solve
-       * is measured against.
-       */
-      std::optional<std::array<double, 2>> predicted_force_scales;
-    };
-
     /**
-     * Move to the next active set after the iterate @p solution (locally
-     * owned entries), whose plain test wants @p changes: the changes of the
-     * prediction, unless a cycle has been detected on this mesh or the
-     * prediction wants none (then @p changes); then the remedy against
-     * cycling, ActiveSetHistory::next().
+     * Move to the next active set after the locally owned vertices
+     * @p changes of the mesh of @p problem want to change: through the
+     * remedy against cycling, ActiveSetHistory::next().
      */
-    Update
+    ActiveSetHistory::Step
     update(const DiscreteProblem<dim>      &problem,
-           const BlockVectorType           &solution,
            const std::vector<StatusChange> &changes);
 
+    /** Cycles detected on this mesh (ActiveSetHistory::cycles()). */
+    unsigned int
+    cycles() const;
+
   private:
-    /**
-     * Sweeps of projected Jacobi in predicted_changes(): more layers than
-     * the free boundary moves between two nested meshes, which grows like
-     * O(h^{−1/3}) at a degenerate free boundary (benchmarks/README.md, "The
-     * prediction of the active set, before and after", measures the layers
-     * and fewer sweeps).
-     */
-    static constexpr unsigned int n_prediction_sweeps = 40;
-
-    /**
-     * The locally owned vertices whose status the test wants to change on
-     * the iterate predicted from @p solution by n_prediction_sweeps sweeps
-     * of projected Jacobi; at the vertices where that test is within the
-     * band, those of @p plain_changes. Leaves the λ_a of the predicted iterate
-     * in `predicted_action`.
-     */
-    std::vector<StatusChange>
-    predicted_changes(const DiscreteProblem<dim>      &problem,
-                      const BlockVectorType           &solution,
-                      const std::vector<StatusChange> &plain_changes);
-
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
 
@@ -412,8 +342,6 @@ namespace membranes
     std::vector<char> active_flags;
     /** The sets visited on this mesh. */
     ActiveSetHistory history;
-    /** λ_a of the predicted iterate (not that of the iterate itself). */
-    DiscreteAction<dim> predicted_action;
   };
 } // namespace membranes
 

@@ -6,6 +6,7 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <membranes/active_set/active_set.h>
+#include <membranes/active_set/active_set_prediction.h>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
@@ -86,8 +87,9 @@ namespace membranes
    * `decoupled`; both give the same iterate), compute λ_a by (4.5)
    * (DiscreteAction), test the KKT conditions, and move to the next active
    * set (ActiveSet, which holds the test Λ_a − c_a W_a > 0, its band of
-   * indifference, the prediction of the next set and the remedy against
-   * cycling).
+   * indifference and the remedy against cycling), by the changes that the
+   * test wants on a predicted iterate (ActiveSetPrediction) unless a cycle
+   * has been detected on the mesh or the prediction wants none.
    *
    * <b>Convergence.</b> The iteration stops when no vertex wants to change
    * and the relative KKT residual (KKTDefects::relative_residual()) is at
@@ -216,7 +218,7 @@ namespace membranes
       double settled_residual;
       /**
        * F_∞ and F^w_∞ (DiscreteAction) of the iterate the active set was
-       * last chosen on, the prediction if ActiveSet::update() made one.
+       * last chosen on, the predicted one if update() made one.
        */
       std::array<double, 2> force_scales;
     };
@@ -243,9 +245,11 @@ namespace membranes
 
     /**
      * Move @p active_set on after the iterate @p solution of iteration
-     * @p iteration, whose test wants @p changes (ActiveSet::update()); say
-     * so if a cycle was remedied, and take the force scales of the
-     * prediction into @p stopping.
+     * @p iteration, whose test wants @p changes: by the changes of the
+     * prediction (ActiveSetPrediction) while no cycle has been detected on
+     * this mesh and the prediction wants some, else by @p changes
+     * (ActiveSet::update()); say so if a cycle was remedied, and take the
+     * force scales of the predicted iterate into @p stopping.
      */
     void
     update(const DiscreteProblem<dim>      &problem,
@@ -253,7 +257,7 @@ namespace membranes
            const VectorType                &solution,
            const std::vector<StatusChange> &changes,
            const unsigned int               iteration,
-           StoppingState                   &stopping) const;
+           StoppingState                   &stopping);
 
     /**
      * The residual norms at which the linear solves stop: those that the
@@ -330,6 +334,9 @@ namespace membranes
     const ConditionalOStream &pcout;
     TimerOutput              &timer;
     const MPI_Comm            mpi_communicator;
+
+    /** The next active set, predicted from an iterate. */
+    ActiveSetPrediction<dim> prediction;
 
     /** The linear problem of one iteration, coupled or decoupled. */
     std::unique_ptr<ActiveSetSystem<dim>> system;
