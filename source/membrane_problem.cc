@@ -25,9 +25,10 @@ namespace membranes
     , triangulation(make_triangulation<dim>(parameters.geometry.cell_type,
                                             mpi_communicator))
     , dof_handler(*triangulation)
+    , dual_mesh(discretization)
     , discrete_problem(discretization, data)
     , active_set(parameters.solver, data, mpi_communicator)
-    , action(discretization, data)
+    , action(data)
     , active_set_solver(parameters.solver,
                         discretization,
                         data,
@@ -36,14 +37,11 @@ namespace membranes
                         mpi_communicator)
     , flux_reconstruction(
         computes_fluxes() ?
-          std::make_unique<FluxReconstruction<dim>>(discretization,
-                                                    data,
-                                                    action) :
+          std::make_unique<FluxReconstruction<dim>>(discretization, data) :
           nullptr)
     , flux_equilibration(
         computes_fluxes() ?
-          std::make_unique<FluxEquilibration<dim>>(*flux_reconstruction,
-                                                   action) :
+          std::make_unique<FluxEquilibration<dim>>(*flux_reconstruction) :
           nullptr)
     , report(parameters.output, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
@@ -88,9 +86,10 @@ namespace membranes
 
   /**
    * The DoFs of the mesh (one per vertex), the hanging node constraints,
-   * and the discrete problem of the mesh (DiscreteProblem: the index sets of
-   * the step-40 layout, the Laplacian, the loads, the vertices of the dual
-   * mesh), which the discrete action and the solver's systems read. The
+   * the interior vertices of the dual mesh (DualMesh), and the discrete
+   * problem of the mesh (DiscreteProblem: the index sets of the step-40
+   * layout, the Laplacian, the loads, V_h and d_a), which the discrete
+   * action and the solver's systems read. The
    * vectors of the mesh: the two blocks (u1h, u2h) of the solution, and
    * λ_h.
    */
@@ -108,8 +107,10 @@ namespace membranes
                                             hanging_node_constraints);
     hanging_node_constraints.close();
 
+    dual_mesh.reinit(dof_handler);
     discrete_problem.reinit(dof_handler,
                             hanging_node_constraints,
+                            dual_mesh,
                             mpi_communicator);
     action.reinit(discrete_problem);
     active_set_solver.setup(discrete_problem,
@@ -242,7 +243,7 @@ namespace membranes
   IdentityRecord
   MembraneProblem<dim>::postprocess()
   {
-    lambda_h = action.lambda_h(hanging_node_constraints);
+    lambda_h = action.lambda_h(discrete_problem, hanging_node_constraints);
 
     const KKTDefects defects =
       active_set.kkt_defects(discrete_problem, action, ghosted_solution);
@@ -279,7 +280,7 @@ namespace membranes
     const auto         errors = ErrorNorms<dim>(discretization, data)
                           .compute(dof_handler,
                                    ghosted_solution,
-                                   action,
+                                   dual_mesh,
                                    lambda_h,
                                    mpi_communicator);
     // The full H1 norm of (3.5) from the seminorm and the L2 norm.
@@ -340,7 +341,8 @@ namespace membranes
     const double       eta = ErrorEstimator<dim>(discretization, data)
                          .residual_estimate(dof_handler,
                                             ghosted_solution,
-                                            action,
+                                            discrete_problem,
+                                            dual_mesh,
                                             lambda_h,
                                             residual_indicators,
                                             mpi_communicator);
@@ -366,6 +368,7 @@ namespace membranes
       return {};
     TimerOutput::Scope scope(computing_timer, "flux");
     flux_equilibration->equilibrate(
+      dof_handler,
       flux_reconstruction->reconstruct(dof_handler, ghosted_solution),
       lambda_h,
       hanging_node_constraints,
@@ -374,10 +377,8 @@ namespace membranes
     FluxRecord flux;
     if (parameters.output.flux_reconstruction)
       {
-        const auto identities =
-          flux_reconstruction->identities(hanging_node_constraints,
-                                          discrete_problem.locally_owned_dofs(),
-                                          mpi_communicator);
+        const auto identities = flux_reconstruction->identities(
+          dof_handler, hanging_node_constraints, discrete_problem, action);
         flux.measure_defect      = identities.measure_defect;
         flux.conservation_defect = identities.conservation_defect;
         flux.balance_defect      = identities.balance_defect;
@@ -387,7 +388,7 @@ namespace membranes
     const auto     estimate = ErrorEstimator<dim>(discretization, data)
                             .flux_estimate(dof_handler,
                                            ghosted_solution,
-                                           action,
+                                           dual_mesh,
                                            lambda_h,
                                            *flux_equilibration,
                                            flux_indicators,
@@ -415,7 +416,7 @@ namespace membranes
   MembraneProblem<dim>::write_unconverged_iterate()
   {
     ghosted_solution = solution;
-    lambda_h         = action.lambda_h(hanging_node_constraints);
+    lambda_h = action.lambda_h(discrete_problem, hanging_node_constraints);
 
     Parameters::Output output = parameters.output;
     output.directory = output_directory.create_subdirectory("unconverged");
@@ -453,7 +454,9 @@ namespace membranes
                        indicators.size() ? &indicators : nullptr);
     if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
-                                   flux_reconstruction->patches(lambda_h),
+                                   flux_reconstruction->patches(dof_handler,
+                                                                dual_mesh,
+                                                                lambda_h),
                                    FluxReconstruction<dim>::data_names());
   }
 

@@ -223,8 +223,9 @@ namespace
       , discretization(cell_type)
       , triangulation(make_triangulation<dim>(cell_type, mpi_communicator))
       , dof_handler(*triangulation)
+      , dual_mesh(discretization)
       , discrete_problem(discretization, data)
-      , action(discretization, data)
+      , action(data)
       , active_set(parameters.solver, data, mpi_communicator)
       , solver(parameters.solver,
                discretization,
@@ -232,7 +233,7 @@ namespace
                pcout,
                timer,
                mpi_communicator)
-      , flux_reconstruction(discretization, data, action)
+      , flux_reconstruction(discretization, data)
     {
       make_mesh(*triangulation);
       discretization.select_mapping(*triangulation);
@@ -247,7 +248,11 @@ namespace
                                            dof_handler,
                                            support_points);
 
-      discrete_problem.reinit(dof_handler, constraints, mpi_communicator);
+      dual_mesh.reinit(dof_handler);
+      discrete_problem.reinit(dof_handler,
+                              constraints,
+                              dual_mesh,
+                              mpi_communicator);
       action.reinit(discrete_problem);
       active_set.reinit(discrete_problem);
       solver.setup(discrete_problem, dof_handler, constraints);
@@ -265,7 +270,7 @@ namespace
     {
       solver.solve(discrete_problem, dof_handler, action, solution, active_set);
       ghosted_solution = solution;
-      lambda_h         = action.lambda_h(constraints);
+      lambda_h         = action.lambda_h(discrete_problem, constraints);
     }
 
     /** The index in vertices() of the vertex of V_h at @p p. */
@@ -304,6 +309,7 @@ namespace
     IndexSet                                      owned_dofs, relevant_dofs;
     AffineConstraints<double>                     constraints;
     std::map<types::global_dof_index, Point<dim>> support_points;
+    DualMesh<dim>                                 dual_mesh;
     DiscreteProblem<dim>                          discrete_problem;
     DiscreteAction<dim>                           action;
     ActiveSet<dim>                                active_set;
@@ -418,7 +424,7 @@ namespace
 
     // The weights of lambda() on the zero iterate, where the two formulas
     // of (4.5) differ (λ_1a = 2, λ_2a = 1): swapped weights give 4/3.
-    problem.action.compute(problem.solution);
+    problem.action.compute(problem.discrete_problem, problem.solution);
     check("Q1 2x2, zero iterate: lambda_1a = -f1",
           problem.action.lambda_from_membrane(0, k),
           2.);
@@ -557,7 +563,7 @@ namespace
     for (unsigned int i = 0; i < 2; ++i)
       check("P1 4 triangles: mu_" + std::to_string(i + 1) + " int grad u_" +
               std::to_string(i + 1) + "h . grad phi_a",
-            problem.action.stiffness_term(i, k),
+            problem.action.stiffness_term(problem.discrete_problem, i, k),
             -(i + 1.) / 9.);
 
     // The dual cell D_a and div t_ih, from the sub-triangles of S_h.
@@ -568,9 +574,12 @@ namespace
       if (problem.triangulation->get_vertices()[v].distance(
             Point<dim>(0.5, 0.5)) < 1e-12)
         a_vertex = v;
-    const auto patches = problem.flux_reconstruction.patches(problem.lambda_h);
-    const auto names   = FluxReconstruction<dim>::data_names();
-    const auto column  = [&](const std::string &name) {
+    const auto patches =
+      problem.flux_reconstruction.patches(problem.dof_handler,
+                                          problem.dual_mesh,
+                                          problem.lambda_h);
+    const auto names  = FluxReconstruction<dim>::data_names();
+    const auto column = [&](const std::string &name) {
       return std::find(names.begin(), names.end(), name) - names.begin();
     };
     const unsigned int sub_triangles_per_cell =
@@ -627,9 +636,10 @@ namespace
     // a fault in its sums over the pieces K ∩ D_a (or in t_ih on a half-edge
     // inside D_a that the float checks above would miss).
     const auto identities =
-      problem.flux_reconstruction.identities(problem.constraints,
-                                             problem.owned_dofs,
-                                             problem.mpi_communicator);
+      problem.flux_reconstruction.identities(problem.dof_handler,
+                                             problem.constraints,
+                                             problem.discrete_problem,
+                                             problem.action);
     check("P1 4 triangles: identities().measure_defect",
           identities.measure_defect,
           0,

@@ -13,6 +13,7 @@
 #include <membranes/active_set/active_set.h>
 #include <membranes/active_set/active_set_solver.h>
 #include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/output/field_output.h>
@@ -124,6 +125,8 @@ namespace membranes
     /** The DoFs of the scalar P1/Q1 element: one per vertex. */
     DoFHandler<dim>           dof_handler;
     AffineConstraints<double> hanging_node_constraints;
+    /** The interior vertices, whose dual cells make up ω_h. */
+    DualMesh<dim> dual_mesh;
     /**
      * Laplacian, loads, d_a and V_h of the current mesh, and its index sets
      * (locally owned and relevant DoFs).

@@ -5,12 +5,11 @@ namespace membranes
 {
   template <int dim>
   ActiveSetPrediction<dim>::ActiveSetPrediction(
-    const Parameters::Solver  &parameters,
-    const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data)
+    const Parameters::Solver &parameters,
+    const ProblemData<dim>   &data)
     : parameters(parameters)
     , data(data)
-    , predicted_action(discretization, data)
+    , predicted_action(data)
   {}
 
 
@@ -77,7 +76,7 @@ namespace membranes
     step -= start_w;
     iterate.block(0).add(mu2 / M, step);
     iterate.block(1).add(-mu1 / M, step);
-    predicted_action.compute(iterate);
+    predicted_action.compute(problem, iterate);
 
     // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
     // indifference; the plain test where the predicted one is in the band.

@@ -66,7 +66,7 @@ namespace membranes
     , pcout(pcout)
     , timer(timer)
     , mpi_communicator(mpi_communicator)
-    , prediction(parameters, discretization, data)
+    , prediction(parameters, data)
     , system(make_active_set_system(parameters,
                                     discretization,
                                     data,
@@ -153,7 +153,8 @@ namespace membranes
       {
         statistics.linearization_estimate =
           linearization_estimate(problem, action, solution, active_set);
-        statistics.algebraic_estimate = algebraic_estimate(action, active_set);
+        statistics.algebraic_estimate =
+          algebraic_estimate(problem, action, active_set);
       }
   }
 
@@ -244,11 +245,12 @@ namespace membranes
 
   template <int dim>
   void
-  ActiveSetSolver<dim>::compute_action(DiscreteAction<dim> &action,
-                                       const VectorType    &solution,
-                                       StoppingState       &stopping) const
+  ActiveSetSolver<dim>::compute_action(const DiscreteProblem<dim> &problem,
+                                       DiscreteAction<dim>        &action,
+                                       const VectorType           &solution,
+                                       StoppingState &stopping) const
   {
-    action.compute(solution);
+    action.compute(problem, solution);
     stopping.force_scales = {
       {action.force_scale(), action.contact_force_scale()}};
   }
@@ -292,12 +294,13 @@ namespace membranes
   template <int dim>
   double
   ActiveSetSolver<dim>::equilibrium_square(
+    const DiscreteProblem<dim>  &problem,
     const DiscreteAction<dim>   &action,
     const unsigned int           k,
     const ActiveSet<dim>        &active_set,
     const std::array<double, 3> &weights) const
   {
-    const auto  &a  = action.vertices()[k];
+    const auto  &a  = problem.vertices()[k];
     const double d  = a.dual_cell_measure;
     const double r1 = action.lambda_from_membrane(0, k) * d;
     const double r2 = action.lambda_from_membrane(1, k) * d;
@@ -317,7 +320,7 @@ namespace membranes
     const ActiveSet<dim>       &active_set) const
   {
     double      energy   = 0;
-    const auto &vertices = action.vertices();
+    const auto &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a    = vertices[k];
@@ -336,14 +339,16 @@ namespace membranes
   template <int dim>
   double
   ActiveSetSolver<dim>::algebraic_estimate(
-    const DiscreteAction<dim> &action,
-    const ActiveSet<dim>      &active_set) const
+    const DiscreteProblem<dim> &problem,
+    const DiscreteAction<dim>  &action,
+    const ActiveSet<dim>       &active_set) const
   {
     const double mu1 = data.mu[0], mu2 = data.mu[1];
     double       sum      = 0;
-    const auto  &vertices = action.vertices();
+    const auto  &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
-      sum += equilibrium_square(action,
+      sum += equilibrium_square(problem,
+                                action,
                                 k,
                                 active_set,
                                 {{1 / mu1, 1 / mu2, 1 / (mu1 + mu2)}}) /
@@ -380,12 +385,12 @@ namespace membranes
         // The forces of the initial guess set the tolerances of the first
         // linear solve.
         if (statistics.iterations == 1)
-          compute_action(action, solution, stopping);
+          compute_action(problem, action, solution, stopping);
         system->solve(problem,
                       solution,
                       linear_tolerances(stopping),
                       statistics);
-        compute_action(action, solution, stopping);
+        compute_action(problem, action, solution, stopping);
         const auto changes =
           active_set.wanted_changes(problem, action, solution);
         const auto n_changes =

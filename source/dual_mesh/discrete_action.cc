@@ -1,17 +1,12 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
-#include <deal.II/fe/fe_values.h>
 #include <membranes/dual_mesh/discrete_action.h>
 
 namespace membranes
 {
   template <int dim>
-  DiscreteAction<dim>::DiscreteAction(const Discretization<dim> &discretization,
-                                      const ProblemData<dim>    &data)
-    : discretization(discretization)
-    , data(data)
-    , dual_cell_quadrature(discretization.fe->reference_cell(), 2)
-    , problem(nullptr)
+  DiscreteAction<dim>::DiscreteAction(const ProblemData<dim> &data)
+    : data(data)
     , max_force(0)
     , max_contact_force(0)
   {}
@@ -20,19 +15,19 @@ namespace membranes
 
   template <int dim>
   void
-  DiscreteAction<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
+  DiscreteAction<dim>::reinit(const DiscreteProblem<dim> &problem)
   {
-    problem = &discrete_problem;
     for (auto &product : stiffness_products)
-      product.reinit(discrete_problem.locally_owned_dofs(),
-                     discrete_problem.get_mpi_communicator());
+      product.reinit(problem.locally_owned_dofs(),
+                     problem.get_mpi_communicator());
   }
 
 
 
   template <int dim>
   void
-  DiscreteAction<dim>::compute(const BlockVectorType &solution)
+  DiscreteAction<dim>::compute(const DiscreteProblem<dim> &problem,
+                               const BlockVectorType      &solution)
   {
     // The two terms of (4.5) at every vertex: μ_i ∫ ∇u_ih·∇φ as μ_i times
     // the product of A with the nodal values U_i of membrane i, block i of
@@ -41,7 +36,7 @@ namespace membranes
     // lifted loads, see stiffness_term()), and the loads ∫ f_i φ of this
     // mesh.
     for (unsigned int i = 0; i < 2; ++i)
-      problem->laplace_matrix().vmult(stiffness_products[i], solution.block(i));
+      problem.laplace_matrix().vmult(stiffness_products[i], solution.block(i));
 
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
@@ -54,8 +49,8 @@ namespace membranes
     // reads many times per iteration.
     // The terms are those of stiffness_term() and load_term(), read from
     // the local storage of the vectors.
-    const auto  &vertices  = problem->vertices();
-    const auto  &positions = problem->local_positions();
+    const auto  &vertices  = problem.vertices();
+    const auto  &positions = problem.local_positions();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
     std::array<const double *, 2> values, products, load_values, lifted_values;
@@ -63,8 +58,8 @@ namespace membranes
       {
         values[i]        = solution.block(i).begin();
         products[i]      = stiffness_products[i].begin();
-        load_values[i]   = problem->loads(i).begin();
-        lifted_values[i] = problem->lifted_loads(i).begin();
+        load_values[i]   = problem.loads(i).begin();
+        lifted_values[i] = problem.lifted_loads(i).begin();
       }
     membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
@@ -95,7 +90,7 @@ namespace membranes
            data.mu_bar * a.stiffness_diagonal *
              std::max(std::abs(values[0][p]), std::abs(values[1][p]))});
       }
-    const MPI_Comm mpi_communicator = problem->get_mpi_communicator();
+    const MPI_Comm mpi_communicator = problem.get_mpi_communicator();
     max_force = Utilities::MPI::max(local_max, mpi_communicator);
     max_contact_force =
       Utilities::MPI::max(local_contact_max, mpi_communicator);
@@ -104,39 +99,21 @@ namespace membranes
 
 
   template <int dim>
-  std::pair<double, double>
-  DiscreteAction<dim>::load_mean_and_oscillation(
-    const typename DoFHandler<dim>::active_cell_iterator &cell,
-    const unsigned int                                    i) const
-  {
-    return problem->load_mean_and_oscillation(cell, i);
-  }
-
-
-
-  template <int dim>
-  const std::vector<typename DiscreteAction<dim>::Vertex> &
-  DiscreteAction<dim>::vertices() const
-  {
-    return problem->vertices();
-  }
-
-
-
-  template <int dim>
   typename DiscreteAction<dim>::VectorType
   DiscreteAction<dim>::lambda_h(
+    const DiscreteProblem<dim>      &problem,
     const AffineConstraints<double> &hanging_node_constraints) const
   {
-    VectorType nodal_values(problem->locally_owned_dofs(),
-                            problem->get_mpi_communicator());
-    for (unsigned int k = 0; k < vertices().size(); ++k)
-      nodal_values[vertices()[k].dof] = lambda(k);
+    const auto &vertices = problem.vertices();
+    VectorType  nodal_values(problem.locally_owned_dofs(),
+                            problem.get_mpi_communicator());
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      nodal_values[vertices[k].dof] = lambda(k);
     nodal_values.compress(VectorOperation::insert);
     hanging_node_constraints.distribute(nodal_values);
-    VectorType ghosted(problem->locally_owned_dofs(),
-                       problem->locally_relevant_dofs(),
-                       problem->get_mpi_communicator());
+    VectorType ghosted(problem.locally_owned_dofs(),
+                       problem.locally_relevant_dofs(),
+                       problem.get_mpi_communicator());
     ghosted = nodal_values;
     return ghosted;
   }
@@ -155,24 +132,26 @@ namespace membranes
 
   template <int dim>
   double
-  DiscreteAction<dim>::stiffness_term(const unsigned int i,
-                                      const unsigned int k) const
+  DiscreteAction<dim>::stiffness_term(const DiscreteProblem<dim> &problem,
+                                      const unsigned int          i,
+                                      const unsigned int          k) const
   {
     // μ_i (A U_i)_a with the columns of the free DoFs, plus those of ∂ω:
     // the loads minus the lifted loads, μ_i Σ_{b ∈ ∂ω} A_ab g_i(b).
-    const unsigned int p = problem->local_positions()[k];
+    const unsigned int p = problem.local_positions()[k];
     return data.mu[i] * stiffness_products[i].begin()[p] +
-           (problem->loads(i).begin()[p] - problem->lifted_loads(i).begin()[p]);
+           (problem.loads(i).begin()[p] - problem.lifted_loads(i).begin()[p]);
   }
 
 
 
   template <int dim>
   double
-  DiscreteAction<dim>::load_term(const unsigned int i,
-                                 const unsigned int k) const
+  DiscreteAction<dim>::load_term(const DiscreteProblem<dim> &problem,
+                                 const unsigned int          i,
+                                 const unsigned int          k) const
   {
-    return problem->loads(i).begin()[problem->local_positions()[k]];
+    return problem.loads(i).begin()[problem.local_positions()[k]];
   }
 
 
@@ -202,82 +181,6 @@ namespace membranes
   DiscreteAction<dim>::contact_force_scale() const
   {
     return max_contact_force;
-  }
-
-
-
-  template <int dim>
-  const DualCellQuadrature<dim> &
-  DiscreteAction<dim>::dual_quadrature() const
-  {
-    return dual_cell_quadrature;
-  }
-
-
-
-  template <int dim>
-  double
-  DiscreteAction<dim>::lambda_h_value(
-    const typename DoFHandler<dim>::active_cell_iterator &cell,
-    const unsigned int                                    v,
-    const VectorType                                     &lambda_h) const
-  {
-    return problem->is_interior_vertex(cell, v) ?
-             lambda_h[cell->vertex_dof_index(v, 0)] :
-             0.;
-  }
-
-
-
-  template <int dim>
-  double
-  DiscreteAction<dim>::lambda_h_at_vertex(const types::global_dof_index a,
-                                          const VectorType &lambda_h) const
-  {
-    return problem->is_interior_vertex(a) ? lambda_h[a] : 0.;
-  }
-
-
-
-  template <int dim>
-  void
-  DiscreteAction<dim>::lambda_h_values(
-    const typename DoFHandler<dim>::active_cell_iterator &cell,
-    const VectorType                                     &lambda_h,
-    std::vector<double>                                  &values,
-    std::vector<bool>                                    *in_omega_h) const
-  {
-    // λ_h is constant on the pieces of each vertex: look it up once per
-    // vertex, not once per point.
-    std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
-    std::array<bool, GeometryInfo<dim>::vertices_per_cell>   vertex_in_omega_h;
-    for (const unsigned int v : cell->vertex_indices())
-      {
-        vertex_values[v]     = lambda_h_value(cell, v, lambda_h);
-        vertex_in_omega_h[v] = problem->is_interior_vertex(cell, v);
-      }
-    values.resize(dual_cell_quadrature.quadrature().size());
-    if (in_omega_h)
-      in_omega_h->resize(values.size());
-    for (unsigned int q = 0; q < values.size(); ++q)
-      {
-        const unsigned int v = dual_cell_quadrature.vertex_of_point(q);
-        values[q]            = vertex_values[v];
-        if (in_omega_h)
-          (*in_omega_h)[q] = vertex_in_omega_h[v];
-      }
-  }
-
-
-
-  template <int dim>
-  void
-  DiscreteAction<dim>::nodal_lambda_values(const FEValues<dim> &fe_values,
-                                           const VectorType    &lambda_h,
-                                           std::vector<double> &values) const
-  {
-    values.resize(fe_values.n_quadrature_points);
-    fe_values.get_function_values(lambda_h, values);
   }
 
 

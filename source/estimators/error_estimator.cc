@@ -22,15 +22,17 @@ namespace membranes
   template <int dim>
   double
   ErrorEstimator<dim>::residual_estimate(
-    const DoFHandler<dim>     &dof_handler,
-    const BlockVectorType     &ghosted_solution,
-    const DiscreteAction<dim> &action,
-    const VectorType          &lambda_h,
-    Vector<double>            &indicators,
-    const MPI_Comm             mpi_communicator) const
+    const DoFHandler<dim>      &dof_handler,
+    const BlockVectorType      &ghosted_solution,
+    const DiscreteProblem<dim> &problem,
+    const DualMesh<dim>        &dual_mesh,
+    const VectorType           &lambda_h,
+    Vector<double>             &indicators,
+    const MPI_Comm              mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    add_cell_terms(dof_handler, ghosted_solution, action, lambda_h, indicators);
+    add_cell_terms(
+      dof_handler, ghosted_solution, problem, dual_mesh, lambda_h, indicators);
     add_jump_terms(dof_handler, ghosted_solution, indicators);
 
     double local_sum = 0;
@@ -48,8 +50,9 @@ namespace membranes
   void
   ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
                                       const BlockVectorType &ghosted_solution,
-                                      const DiscreteAction<dim> &action,
-                                      const VectorType          &lambda_h,
+                                      const DiscreteProblem<dim> &problem,
+                                      const DualMesh<dim>        &dual_mesh,
+                                      const VectorType           &lambda_h,
                                       Vector<double> &indicators) const
   {
     const FiniteElement<dim> &fe = *discretization.fe;
@@ -61,11 +64,11 @@ namespace membranes
     struct Scratch
     {
       Scratch(const Discretization<dim> &discretization,
-              const DiscreteAction<dim> &action,
+              const DualMesh<dim>       &dual_mesh,
               const VectorType          &lambda_h,
               const bool                 with_laplacians)
         : values(discretization,
-                 action,
+                 dual_mesh,
                  lambda_h,
                  update_values | update_JxW_values |
                    (with_laplacians ? update_hessians : update_default))
@@ -88,7 +91,7 @@ namespace membranes
       dof_handler,
       [&]() {
         return std::make_unique<Scratch>(discretization,
-                                         action,
+                                         dual_mesh,
                                          lambda_h,
                                          with_laplacians);
       },
@@ -114,7 +117,7 @@ namespace membranes
             // f_ih = f̄_iK and ‖f_i − f_ih‖²_K, on the quadrature of the
             // assembly.
             const auto [f_mean, oscillation] =
-              action.load_mean_and_oscillation(cell, i);
+              problem.load_mean_and_oscillation(cell, i);
 
             double residual = 0;
             for (const unsigned int q : fe_values.quadrature_point_indices())
@@ -367,10 +370,10 @@ namespace membranes
   struct ErrorEstimator<dim>::FluxScratch
   {
     FluxScratch(const Discretization<dim> &discretization,
-                const DiscreteAction<dim> &action,
+                const DualMesh<dim>       &dual_mesh,
                 const VectorType          &lambda_h)
       : values(discretization,
-               action,
+               dual_mesh,
                lambda_h,
                update_values | update_gradients | update_jacobians |
                  update_JxW_values)
@@ -423,7 +426,7 @@ namespace membranes
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>        &dof_handler,
     const BlockVectorType        &ghosted_solution,
-    const DiscreteAction<dim>    &action,
+    const DualMesh<dim>          &dual_mesh,
     const VectorType             &lambda_h,
     const FluxEquilibration<dim> &flux_equilibration,
     Vector<double>               &indicators,
@@ -434,14 +437,15 @@ namespace membranes
     run_on_cells<FluxTerms>(
       dof_handler,
       [&]() {
-        return std::make_unique<FluxScratch>(discretization, action, lambda_h);
+        return std::make_unique<FluxScratch>(discretization,
+                                             dual_mesh,
+                                             lambda_h);
       },
       [&](const CellIterator &cell, FluxScratch &scratch, FluxTerms &terms) {
         terms = FluxTerms();
         if (!cell->is_locally_owned())
           return;
-        terms = flux_terms(
-          cell, ghosted_solution, action, flux_equilibration, scratch);
+        terms = flux_terms(cell, ghosted_solution, flux_equilibration, scratch);
         indicators[cell->active_cell_index()] = terms.eta_squared();
       },
       [&](const FluxTerms &terms) { sums += terms; });
@@ -471,15 +475,15 @@ namespace membranes
   ErrorEstimator<dim>::flux_terms(
     const CellIterator           &cell,
     const BlockVectorType        &ghosted_solution,
-    const DiscreteAction<dim>    &action,
     const FluxEquilibration<dim> &flux_equilibration,
     FluxScratch                  &scratch) const
   {
     scratch.values.reinit(cell, ghosted_solution);
     const FEValues<dim> &fe_values = scratch.values.fe_values;
-    action.nodal_lambda_values(fe_values,
-                               scratch.values.nodal_lambda_h,
-                               scratch.lambda);
+    // λ̃_h = Σ_a λ_a φ_a, the P1/Q1 function of the nodal values of λ_h.
+    scratch.lambda.resize(fe_values.n_quadrature_points);
+    fe_values.get_function_values(scratch.values.nodal_lambda_h,
+                                  scratch.lambda);
     const std::array<double, 2>      sign{{1., -1.}};
     const double                     h_K = cell->diameter();
     const FEValuesExtractors::Scalar scalar(0);

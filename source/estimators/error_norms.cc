@@ -17,11 +17,11 @@ namespace membranes
 
   template <int dim>
   typename ErrorNorms<dim>::Errors
-  ErrorNorms<dim>::compute(const DoFHandler<dim>     &dof_handler,
-                           const BlockVectorType     &ghosted_solution,
-                           const DiscreteAction<dim> &action,
-                           const VectorType          &lambda_h,
-                           const MPI_Comm             mpi_communicator) const
+  ErrorNorms<dim>::compute(const DoFHandler<dim> &dof_handler,
+                           const BlockVectorType &ghosted_solution,
+                           const DualMesh<dim>   &dual_mesh,
+                           const VectorType      &lambda_h,
+                           const MPI_Comm         mpi_communicator) const
   {
     // All six norms in one pass over the cells (see the class comment for
     // why not VectorTools::integrate_difference()).
@@ -31,10 +31,10 @@ namespace membranes
     struct Scratch
     {
       Scratch(const Discretization<dim> &discretization,
-              const DiscreteAction<dim> &action,
+              const DualMesh<dim>       &dual_mesh,
               const VectorType          &lambda_h)
         : values(discretization,
-                 action,
+                 dual_mesh,
                  lambda_h,
                  update_values | update_gradients | update_quadrature_points |
                    update_JxW_values)
@@ -58,7 +58,7 @@ namespace membranes
     run_on_cells<Squares>(
       dof_handler,
       [&]() {
-        return std::make_unique<Scratch>(discretization, action, lambda_h);
+        return std::make_unique<Scratch>(discretization, dual_mesh, lambda_h);
       },
       [&](const auto &cell, Scratch &scratch, Squares &cell_squares) {
         cell_squares = Squares{};

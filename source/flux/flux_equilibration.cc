@@ -42,10 +42,8 @@ namespace membranes
 
   template <int dim>
   FluxEquilibration<dim>::FluxEquilibration(
-    const FluxReconstruction<dim> &reconstruction,
-    const DiscreteAction<dim>     &action)
+    const FluxReconstruction<dim> &reconstruction)
     : reconstruction(reconstruction)
-    , action(action)
     , basis(reconstruction.sub_triangle_basis())
   {}
 
@@ -69,7 +67,7 @@ namespace membranes
                                       std::vector<double> &divergence) const
   {
     const DualCellQuadrature<dim> &dual_cell_quadrature =
-      action.dual_quadrature();
+      basis.dual_quadrature();
     const auto        &quadrature  = dual_cell_quadrature.quadrature();
     const auto        &triangles   = dual_cell_quadrature.sub_triangles();
     const unsigned int n_triangles = triangles.size();
@@ -154,6 +152,7 @@ namespace membranes
   template <int dim>
   void
   FluxEquilibration<dim>::equilibrate(
+    const DoFHandler<dim>           &dof_handler,
     const AlignedVector<PatchTerms> &patch_terms,
     const VectorType                &lambda_h,
     const AffineConstraints<double> &hanging_node_constraints,
@@ -164,7 +163,8 @@ namespace membranes
     // cells of one a in the order of the cells), and the others, to be
     // sent to a's owner.
     std::vector<PatchMember> local_members, remote_members;
-    for (const PatchMember &member : patch_members(hanging_node_constraints))
+    for (const PatchMember &member :
+         patch_members(dof_handler, hanging_node_constraints))
       (locally_owned_dofs.is_element(member.a) ? local_members : remote_members)
         .push_back(member);
     std::stable_sort(local_members.begin(),
@@ -186,8 +186,8 @@ namespace membranes
       for (unsigned int r = 0; r < remote.sent[process].size(); ++r)
         add_patch_result(remote.sent[process][r],
                          buffer.data() + r * 6 * basis.ring().size());
-    relax_rotations();
-    relax_cell_rotations();
+    relax_rotations(dof_handler);
+    relax_cell_rotations(dof_handler);
   }
 
 
@@ -195,10 +195,10 @@ namespace membranes
   template <int dim>
   std::vector<typename FluxEquilibration<dim>::PatchMember>
   FluxEquilibration<dim>::patch_members(
+    const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints) const
   {
     std::vector<PatchMember> members;
-    const DoFHandler<dim>   &dof_handler = reconstruction.get_dof_handler();
     members.reserve(dof_handler.get_triangulation().n_active_cells() *
                     GeometryInfo<dim>::vertices_per_cell);
     // The condensed hat functions of one cell, by increasing a: at most two
@@ -374,9 +374,8 @@ namespace membranes
           scratch.result.push_back(remote.replies.at(process).data() +
                                    r * result_size);
         }
-    scratch.problem.solve(action.lambda_h_at_vertex(a, lambda_h),
-                          scratch.patch,
-                          scratch.result);
+    // λ_a at a, zero on ∂ω (DiscreteAction::lambda_h()); a is not hanging.
+    scratch.problem.solve(lambda_h[a], scratch.patch, scratch.result);
   }
 
 

@@ -135,12 +135,10 @@ namespace membranes
   template <int dim>
   FluxReconstruction<dim>::FluxReconstruction(
     const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data,
-    const DiscreteAction<dim> &action)
+    const ProblemData<dim>    &data)
     : discretization(discretization)
     , data(data)
-    , action(action)
-    , dual_cell_quadrature(action.dual_quadrature())
+    , dual_cell_quadrature(discretization.dual_cell_quadrature)
     , basis(dual_cell_quadrature, *discretization.fe)
   {}
 
@@ -151,7 +149,6 @@ namespace membranes
   FluxReconstruction<dim>::reconstruct(const DoFHandler<dim> &dof_handler,
                                        const BlockVectorType &ghosted_solution)
   {
-    this->dof_handler = &dof_handler;
     const unsigned int n_cells =
       dof_handler.get_triangulation().n_active_cells();
     const unsigned int n_triangles = basis.n_sub_triangles();
@@ -167,7 +164,10 @@ namespace membranes
     patch_terms.resize_fast(n_cells * n_triangles);
     hat_integrals.assign(n_cells, {});
 
-    set_half_edge_fluxes(compute_local_fluxes(ghosted_solution, patch_terms));
+    set_half_edge_fluxes(dof_handler,
+                         compute_local_fluxes(dof_handler,
+                                              ghosted_solution,
+                                              patch_terms));
     return patch_terms;
   }
 
@@ -186,18 +186,19 @@ namespace membranes
   template <int dim>
   typename FluxReconstruction<dim>::HalfEdgeMinimization
   FluxReconstruction<dim>::compute_local_fluxes(
+    const DoFHandler<dim>     &dof_handler,
     const BlockVectorType     &ghosted_solution,
     AlignedVector<PatchTerms> &patch_terms)
   {
     const unsigned int   n_entries = sub_triangle_data.size();
     HalfEdgeMinimization minimization;
     minimization.free_flux_index.assign(
-      2 * dof_handler->get_triangulation().n_raw_faces(),
+      2 * dof_handler.get_triangulation().n_raw_faces(),
       numbers::invalid_unsigned_int);
     minimization.free_flux_of.resize(n_entries);
     minimization.free_fluxes.reserve(n_entries);
     run_on_cells<LocalFluxCopy>(
-      *dof_handler,
+      dof_handler,
       [&]() {
         return std::make_unique<LocalFluxScratch>(discretization,
                                                   basis.points());
@@ -502,10 +503,11 @@ namespace membranes
   template <int dim>
   void
   FluxReconstruction<dim>::set_half_edge_fluxes(
+    const DoFHandler<dim>      &dof_handler,
     const HalfEdgeMinimization &minimization)
   {
     const unsigned int n_triangles = basis.n_sub_triangles();
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         for (unsigned int s = 0; s < n_triangles; ++s)
           {
@@ -523,11 +525,12 @@ namespace membranes
   template <int dim>
   typename FluxReconstruction<dim>::DualCellSums
   FluxReconstruction<dim>::dual_cell_sums(
+    const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints,
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator) const
   {
-    const FiniteElement<dim> &fe          = dof_handler->get_fe();
+    const FiniteElement<dim> &fe          = dof_handler.get_fe();
     const auto               &triangles   = basis.sub_triangles();
     const unsigned int        n_triangles = triangles.size();
 
@@ -551,7 +554,7 @@ namespace membranes
                           &local_load_on_hats[i]})
         local->reinit(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell->get_dof_indices(dof_indices);
@@ -615,16 +618,19 @@ namespace membranes
   template <int dim>
   typename FluxReconstruction<dim>::Identities
   FluxReconstruction<dim>::identities(
+    const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints,
-    const IndexSet                  &locally_owned_dofs,
-    const MPI_Comm                   mpi_communicator) const
+    const DiscreteProblem<dim>      &problem,
+    const DiscreteAction<dim>       &action) const
   {
+    const MPI_Comm mpi_communicator = problem.get_mpi_communicator();
     const auto &[measure, divergence, load_on_pieces, load_on_hats] =
-      dual_cell_sums(hanging_node_constraints,
-                     locally_owned_dofs,
+      dual_cell_sums(dof_handler,
+                     hanging_node_constraints,
+                     problem.locally_owned_dofs(),
                      mpi_communicator);
     Identities  defects;
-    const auto &vertices = action.vertices();
+    const auto &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto &a   = vertices[k];
@@ -640,10 +646,11 @@ namespace membranes
             const double load_on_pieces_i = load_on_pieces.block(i)[dof];
             defects.conservation_defect =
               std::max(defects.conservation_defect,
-                       std::abs(divergence_i - action.stiffness_term(i, k)));
+                       std::abs(divergence_i -
+                                action.stiffness_term(problem, i, k)));
             // ∫ (f_i − f_ih) φ_a with the assembly's ∫ f_i φ_a.
             const double oscillation =
-              action.load_term(i, k) - load_on_hats.block(i)[dof];
+              action.load_term(problem, i, k) - load_on_hats.block(i)[dof];
             defects.balance_defect = std::max(
               defects.balance_defect,
               std::abs(sign * action.lambda_from_membrane(i, k) * measure[dof] -
@@ -698,7 +705,9 @@ namespace membranes
 
   template <int dim>
   std::vector<DataOutBase::Patch<dim, dim>>
-  FluxReconstruction<dim>::patches(const VectorType &lambda_h) const
+  FluxReconstruction<dim>::patches(const DoFHandler<dim> &dof_handler,
+                                   const DualMesh<dim>   &dual_mesh,
+                                   const VectorType      &lambda_h) const
   {
     const auto            &triangles = basis.sub_triangles();
     SubTrianglePoints<dim> points(dual_cell_quadrature, true);
@@ -707,7 +716,7 @@ namespace membranes
                             points.quadrature,
                             update_quadrature_points | update_jacobians);
     std::vector<DataOutBase::Patch<dim, dim>> patches;
-    for (const auto &cell : dof_handler->active_cell_iterators())
+    for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           fe_values.reinit(cell);
@@ -729,7 +738,9 @@ namespace membranes
                   const double det = std::abs(determinant(DF));
                   patch.data(0, j) = cell->vertex_index(triangles[s].vertex);
                   patch.data(1, j) =
-                    action.lambda_h_value(cell, triangles[s].vertex, lambda_h);
+                    dual_mesh.lambda_h_value(cell,
+                                             triangles[s].vertex,
+                                             lambda_h);
                   for (unsigned int i = 0; i < 2; ++i)
                     {
                       const Tensor<1, dim> t =
@@ -746,15 +757,6 @@ namespace membranes
             }
         }
     return patches;
-  }
-
-
-
-  template <int dim>
-  const DoFHandler<dim> &
-  FluxReconstruction<dim>::get_dof_handler() const
-  {
-    return *dof_handler;
   }
 
 

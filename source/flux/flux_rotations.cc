@@ -202,12 +202,11 @@ namespace membranes
    */
   template <int dim>
   void
-  FluxEquilibration<dim>::relax_rotations()
+  FluxEquilibration<dim>::relax_rotations(const DoFHandler<dim> &dof_handler)
   {
-    Rotations              rotations   = rotations_around_vertices();
+    Rotations              rotations   = rotations_around_vertices(dof_handler);
     const unsigned int     n_triangles = basis.n_sub_triangles();
     GhostCellExchange<dim> ghost_cells;
-    const DoFHandler<dim> &dof_handler = reconstruction.get_dof_handler();
     ghost_cells.reinit(dof_handler.get_triangulation(),
                        dof_handler.get_communicator());
 
@@ -259,16 +258,16 @@ namespace membranes
    */
   template <int dim>
   typename FluxEquilibration<dim>::Rotations
-  FluxEquilibration<dim>::rotations_around_vertices() const
+  FluxEquilibration<dim>::rotations_around_vertices(
+    const DoFHandler<dim> &dof_handler) const
   {
-    const DoFHandler<dim> &dof_handler   = reconstruction.get_dof_handler();
-    const auto            &triangles     = basis.sub_triangles();
-    const unsigned int     n_triangles   = triangles.size();
-    const auto             order         = counterclockwise_corners(triangles);
-    const auto            &triangulation = dof_handler.get_triangulation();
-    const unsigned int     n_vertices    = triangulation.n_vertices();
-    const unsigned int first_cell = n_vertices + triangulation.n_raw_faces();
-    const unsigned int n_nodes    = first_cell + triangulation.n_active_cells();
+    const auto        &triangles     = basis.sub_triangles();
+    const unsigned int n_triangles   = triangles.size();
+    const auto         order         = counterclockwise_corners(triangles);
+    const auto        &triangulation = dof_handler.get_triangulation();
+    const unsigned int n_vertices    = triangulation.n_vertices();
+    const unsigned int first_cell    = n_vertices + triangulation.n_raw_faces();
+    const unsigned int n_nodes = first_cell + triangulation.n_active_cells();
     std::vector<RotationEntry> entries;
     entries.reserve(triangulation.n_active_cells() * n_triangles * 3);
     std::vector<char> owned(n_nodes, 0), on_boundary(n_nodes, 0);
@@ -378,12 +377,12 @@ namespace membranes
    */
   template <int dim>
   void
-  FluxEquilibration<dim>::relax_cell_rotations()
+  FluxEquilibration<dim>::relax_cell_rotations(
+    const DoFHandler<dim> &dof_handler)
   {
-    const auto            &triangles   = basis.sub_triangles();
-    const unsigned int     n_triangles = triangles.size();
-    const DoFHandler<dim> &dof_handler = reconstruction.get_dof_handler();
-    const unsigned int     n_vertices =
+    const auto        &triangles   = basis.sub_triangles();
+    const unsigned int n_triangles = triangles.size();
+    const unsigned int n_vertices =
       dof_handler.get_fe().reference_cell().n_vertices();
     // The bubble of edge 0 of κ (from m_e to b_K) is unknown n_vertices + e,
     // that of edge 1 (from a to b_K) unknown a.
@@ -435,7 +434,7 @@ namespace membranes
 
 
   template void
-  FluxEquilibration<2>::relax_rotations();
+  FluxEquilibration<2>::relax_rotations(const DoFHandler<2> &);
   template void
-  FluxEquilibration<2>::relax_cell_rotations();
+  FluxEquilibration<2>::relax_cell_rotations(const DoFHandler<2> &);
 } // namespace membranes

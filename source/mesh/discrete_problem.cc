@@ -55,6 +55,7 @@ namespace membranes
   DiscreteProblem<dim>::reinit(
     const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &hanging_node_constraints,
+    const DualMesh<dim>             &dual_mesh,
     const MPI_Comm                   mpi_communicator)
   {
     this->mpi_communicator = mpi_communicator;
@@ -92,7 +93,7 @@ namespace membranes
              membrane_constraints,
              dual_cell_measure,
              stiffness_diagonal);
-    find_vertices(dof_handler,
+    find_vertices(dual_mesh,
                   hanging_node_constraints,
                   dual_cell_measure,
                   stiffness_diagonal);
@@ -209,31 +210,11 @@ namespace membranes
   template <int dim>
   void
   DiscreteProblem<dim>::find_vertices(
-    const DoFHandler<dim>           &dof_handler,
+    const DualMesh<dim>             &dual_mesh,
     const AffineConstraints<double> &hanging_node_constraints,
     const VectorType                &dual_cell_measure,
     const VectorType                &stiffness_diagonal)
   {
-    // The interior vertices of the owned and ghost cells, each once (by
-    // its index in the mesh), by their DoFs.
-    const IndexSet boundary_dofs = DoFTools::extract_boundary_dofs(dof_handler);
-    const auto    &triangulation = dof_handler.get_triangulation();
-    std::vector<char> seen(triangulation.n_vertices(), false);
-    interior_vertex_flags.assign(triangulation.n_vertices(), false);
-    std::vector<types::global_dof_index> candidates;
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (!cell->is_artificial())
-        for (const unsigned int v : cell->vertex_indices())
-          if (!seen[cell->vertex_index(v)])
-            {
-              seen[cell->vertex_index(v)] = true;
-              if (boundary_dofs.is_element(cell->vertex_dof_index(v, 0)))
-                continue;
-              interior_vertex_flags[cell->vertex_index(v)] = true;
-              candidates.push_back(cell->vertex_dof_index(v, 0));
-            }
-    std::sort(candidates.begin(), candidates.end());
-
     // The l1 norms of the locally owned rows of A, by Epetra's own row sums
     // of absolute values (deal.II's row iterator of a Trilinos matrix
     // resizes its row buffer to n() entries on every row it visits, which
@@ -243,13 +224,12 @@ namespace membranes
                   *row_l1_norm.trilinos_vector()(0)) == 0,
                 ExcInternalError());
 
-    // V_h: the unconstrained ones; its owned vertices carry λ_a.
+    // V_h: the unconstrained interior vertices; its owned vertices carry
+    // λ_a.
     interior_vertices.clear();
     relevant_vertices.clear();
-    interior_vertex_dofs = IndexSet(dof_handler.n_dofs());
-    for (const auto dof : candidates)
+    for (const auto dof : dual_mesh.interior_vertices())
       {
-        interior_vertex_dofs.add_index(dof);
         if (hanging_node_constraints.is_constrained(dof))
           continue;
         relevant_vertices.push_back(dof);
@@ -259,7 +239,6 @@ namespace membranes
                                        stiffness_diagonal[dof],
                                        1 / row_l1_norm[dof]});
       }
-    interior_vertex_dofs.compress();
     positions.resize(interior_vertices.size());
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
       positions[k] = owned_dofs.index_within_set(interior_vertices[k].dof);
@@ -367,16 +346,6 @@ namespace membranes
   DiscreteProblem<dim>::locally_relevant_vertices() const
   {
     return relevant_vertices;
-  }
-
-
-
-  template <int dim>
-  bool
-  DiscreteProblem<dim>::is_interior_vertex(
-    const types::global_dof_index a) const
-  {
-    return interior_vertex_dofs.is_element(a);
   }
 
 

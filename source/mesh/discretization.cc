@@ -181,6 +181,7 @@ namespace membranes
     , fe(make_fe<dim>(cell_type))
     , mapping(make_mapping<dim>(cell_type))
     , cell_quadrature(make_cell_quadrature<dim>(cell_type))
+    , dual_cell_quadrature(fe->reference_cell(), 2)
   {}
 
 

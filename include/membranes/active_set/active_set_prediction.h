@@ -6,7 +6,6 @@
 #include <membranes/active_set/active_set.h>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/mesh/discrete_problem.h>
-#include <membranes/mesh/discretization.h>
 #include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
 #include <vector>
@@ -69,9 +68,8 @@ namespace membranes
     using VectorType      = TrilinosWrappers::MPI::Vector;
     using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
-    ActiveSetPrediction(const Parameters::Solver  &parameters,
-                        const Discretization<dim> &discretization,
-                        const ProblemData<dim>    &data);
+    ActiveSetPrediction(const Parameters::Solver &parameters,
+                        const ProblemData<dim>   &data);
 
     /** Work on the mesh of @p problem. */
     void

@@ -235,13 +235,14 @@ namespace membranes
     start(const double expected_error) const;
 
     /**
-     * λ_a of the iterate @p solution into @p action, and its force scales
-     * into @p stopping.
+     * λ_a of the iterate @p solution on the mesh of @p problem into
+     * @p action, and its force scales into @p stopping.
      */
     void
-    compute_action(DiscreteAction<dim> &action,
-                   const VectorType    &solution,
-                   StoppingState       &stopping) const;
+    compute_action(const DiscreteProblem<dim> &problem,
+                   DiscreteAction<dim>        &action,
+                   const VectorType           &solution,
+                   StoppingState              &stopping) const;
 
     /**
      * Move @p active_set on after the iterate @p solution of iteration
@@ -304,12 +305,14 @@ namespace membranes
 
     /**
      * The squared residual of the equilibrium part of the KKT conditions at
-     * the k-th vertex of @p action, weighted: with r_ia = λ_ia d_a,
-     * @p weights[0] r_1a² + @p weights[1] r_2a² on an inactive vertex,
-     * @p weights[2] (r_1a − r_2a)² on an active one.
+     * the k-th vertex a of V_h (DiscreteProblem::vertices()), weighted:
+     * with r_ia = λ_ia d_a from @p action, @p weights[0] r_1a² +
+     * @p weights[1] r_2a² on an inactive vertex, @p weights[2]
+     * (r_1a − r_2a)² on an active one.
      */
     double
-    equilibrium_square(const DiscreteAction<dim>   &action,
+    equilibrium_square(const DiscreteProblem<dim>  &problem,
+                       const DiscreteAction<dim>   &action,
                        const unsigned int           k,
                        const ActiveSet<dim>        &active_set,
                        const std::array<double, 3> &weights) const;
@@ -326,8 +329,9 @@ namespace membranes
 
     /** η_alg of an iterate with λ_a in @p action, over all processes. */
     double
-    algebraic_estimate(const DiscreteAction<dim> &action,
-                       const ActiveSet<dim>      &active_set) const;
+    algebraic_estimate(const DiscreteProblem<dim> &problem,
+                       const DiscreteAction<dim>  &action,
+                       const ActiveSet<dim>       &active_set) const;
 
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;

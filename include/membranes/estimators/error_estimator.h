@@ -8,7 +8,8 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
-#include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/dual_mesh/dual_mesh.h>
+#include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
@@ -146,16 +147,17 @@ namespace membranes
      * The residual estimator: fill @p indicators (indexed by
      * active_cell_index(), zero on cells not locally owned) with its η_K²
      * and return η over all processes, with @p ghosted_solution the blocks
-     * u1h, u2h (ghosted) and @p lambda_h the λ_h of @p action
-     * (DiscreteAction::lambda_h()).
+     * u1h, u2h (ghosted), the loads of @p problem, and @p lambda_h
+     * (DiscreteAction::lambda_h()) read on the dual cells of @p dual_mesh.
      */
     double
-    residual_estimate(const DoFHandler<dim>     &dof_handler,
-                      const BlockVectorType     &ghosted_solution,
-                      const DiscreteAction<dim> &action,
-                      const VectorType          &lambda_h,
-                      Vector<double>            &indicators,
-                      const MPI_Comm             mpi_communicator) const;
+    residual_estimate(const DoFHandler<dim>      &dof_handler,
+                      const BlockVectorType      &ghosted_solution,
+                      const DiscreteProblem<dim> &problem,
+                      const DualMesh<dim>        &dual_mesh,
+                      const VectorType           &lambda_h,
+                      Vector<double>             &indicators,
+                      const MPI_Comm              mpi_communicator) const;
 
     /**
      * The flux estimator: the same with the equilibrated fluxes of
@@ -164,7 +166,7 @@ namespace membranes
     FluxEstimate
     flux_estimate(const DoFHandler<dim>        &dof_handler,
                   const BlockVectorType        &ghosted_solution,
-                  const DiscreteAction<dim>    &action,
+                  const DualMesh<dim>          &dual_mesh,
                   const VectorType             &lambda_h,
                   const FluxEquilibration<dim> &flux_equilibration,
                   Vector<double>               &indicators,
@@ -175,11 +177,12 @@ namespace membranes
 
     /** Element residuals, oscillation and the contact term. */
     void
-    add_cell_terms(const DoFHandler<dim>     &dof_handler,
-                   const BlockVectorType     &ghosted_solution,
-                   const DiscreteAction<dim> &action,
-                   const VectorType          &lambda_h,
-                   Vector<double>            &indicators) const;
+    add_cell_terms(const DoFHandler<dim>      &dof_handler,
+                   const BlockVectorType      &ghosted_solution,
+                   const DiscreteProblem<dim> &problem,
+                   const DualMesh<dim>        &dual_mesh,
+                   const VectorType           &lambda_h,
+                   Vector<double>             &indicators) const;
 
     /** The boundary data part of FluxEstimate. */
     double
@@ -249,7 +252,6 @@ namespace membranes
     FluxTerms
     flux_terms(const CellIterator           &cell,
                const BlockVectorType        &ghosted_solution,
-               const DiscreteAction<dim>    &action,
                const FluxEquilibration<dim> &flux_equilibration,
                FluxScratch                  &scratch) const;
 

@@ -6,7 +6,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
-#include <membranes/dual_mesh/discrete_action.h>
+#include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/problem_data.h>
 
@@ -23,18 +23,17 @@ namespace membranes
    * one on ω; where λ does not vanish on ∂ω, the strip alone contributes
    * ‖λ‖_{L2(ω∖ω_h)} = O(h^{1/2}) to it.
    *
-   * All integrals use the DualCellQuadrature of DiscreteAction, so
+   * All integrals use the DualCellQuadrature of the Discretization, so
    * that each quadrature point knows the dual cell D_a it lies in and λ_h
-   * is evaluated exactly; the same rule integrates the displacement errors
-   * over the whole cell, in one pass: one call of the exact solution
+   * is evaluated exactly (DualMesh); the same rule integrates the displacement
+   * errors over the whole cell, in one pass: one call of the exact solution
    * (ProblemData::exact_solution_list(), compiled) gives u1, u2, their
    * gradients and λ together. VectorTools::integrate_difference() takes
    * one pass and one evaluation of the exact solution per norm and
-   * membrane; measured on case M (5.3·10⁵ DoFs), its four passes and one
-   * for λ took 4.4 times as long (2.40 against 0.55 s on Q1, 4.50 against
-   * 1.02 s on P1; 4.3 times on one thread), and with QGauss(2) its L2
-   * errors came out 2 to 6 % low (the Gauss points are where the error of
-   * a bilinear interpolant is smallest).
+   * membrane, five passes in all (benchmarks/README.md, "Error norms in
+   * one pass"), and with QGauss(2) its L2 errors come out 2 to 6 % low
+   * (the Gauss points are where the error of a bilinear interpolant is
+   * smallest).
    */
   template <int dim>
   class ErrorNorms
@@ -56,14 +55,15 @@ namespace membranes
 
     /**
      * The errors of @p ghosted_solution (the blocks u1h, u2h, ghosted), with
-     * @p lambda_h the λ_h of @p action (DiscreteAction::lambda_h()).
+     * @p lambda_h (DiscreteAction::lambda_h()) read on the dual cells of
+     * @p dual_mesh.
      */
     Errors
-    compute(const DoFHandler<dim>     &dof_handler,
-            const BlockVectorType     &ghosted_solution,
-            const DiscreteAction<dim> &action,
-            const VectorType          &lambda_h,
-            const MPI_Comm             mpi_communicator) const;
+    compute(const DoFHandler<dim> &dof_handler,
+            const BlockVectorType &ghosted_solution,
+            const DualMesh<dim>   &dual_mesh,
+            const VectorType      &lambda_h,
+            const MPI_Comm         mpi_communicator) const;
 
   private:
     const Discretization<dim> &discretization;

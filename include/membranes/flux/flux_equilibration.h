@@ -9,7 +9,6 @@
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <map>
-#include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/flux/flux_patch_problem.h>
 #include <membranes/flux/flux_reconstruction.h>
 #include <membranes/flux/flux_sub_triangles.h>
@@ -112,11 +111,10 @@ namespace membranes
     using PatchTerms   = typename FluxReconstruction<dim>::PatchTerms;
 
     /**
-     * The equilibration of the fluxes of @p reconstruction, for the
-     * discrete action @p action; both must live as long as this object.
+     * The equilibration of the fluxes of @p reconstruction, which must
+     * live as long as this object.
      */
-    FluxEquilibration(const FluxReconstruction<dim> &reconstruction,
-                      const DiscreteAction<dim>     &action);
+    explicit FluxEquilibration(const FluxReconstruction<dim> &reconstruction);
 
     /**
      * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch problems
@@ -124,12 +122,13 @@ namespace membranes
      * comment), each solved by the owner of a on the records of its cells,
      * with @p patch_terms from FluxReconstruction::reconstruct() and the
      * λ_a of @p lambda_h (DiscreteAction::lambda_h()); then the rotations.
-     * @p hanging_node_constraints and @p locally_owned_dofs are those of the
-     * DoFHandler of the reconstruction (one DoF per vertex), by which the
-     * vertices a and their owners are found.
+     * @p dof_handler is the one of the last reconstruct() (one DoF per
+     * vertex), @p hanging_node_constraints and @p locally_owned_dofs are
+     * its own, by which the vertices a and their owners are found.
      */
     void
-    equilibrate(const AlignedVector<PatchTerms> &patch_terms,
+    equilibrate(const DoFHandler<dim>           &dof_handler,
+                const AlignedVector<PatchTerms> &patch_terms,
                 const VectorType                &lambda_h,
                 const AffineConstraints<double> &hanging_node_constraints,
                 const IndexSet                  &locally_owned_dofs,
@@ -137,7 +136,7 @@ namespace membranes
 
     /**
      * σ_ih and div σ_ih of membrane @p i at the points of
-     * DiscreteAction::dual_quadrature() on the cell @p fe_values was last
+     * Discretization::dual_cell_quadrature on the cell @p fe_values was last
      * reinit'ed on (with update_jacobians).
      */
     void
@@ -200,6 +199,7 @@ namespace membranes
      */
     std::vector<PatchMember>
     patch_members(
+      const DoFHandler<dim>           &dof_handler,
       const AffineConstraints<double> &hanging_node_constraints) const;
 
     /**
@@ -264,14 +264,14 @@ namespace membranes
      * in rotation_sweeps sweeps (see the .cc file).
      */
     void
-    relax_rotations();
+    relax_rotations(const DoFHandler<dim> &dof_handler);
 
     /**
      * The rotations around the vertices p of S_h not on ∂ω that an owned
      * cell touches, grouped by the kind of p.
      */
     Rotations
-    rotations_around_vertices() const;
+    rotations_around_vertices(const DoFHandler<dim> &dof_handler) const;
 
     /** Sweeps of relax_rotations(). */
     static constexpr unsigned int rotation_sweeps = 3;
@@ -283,10 +283,9 @@ namespace membranes
      * .cc file).
      */
     void
-    relax_cell_rotations();
+    relax_cell_rotations(const DoFHandler<dim> &dof_handler);
 
     const FluxReconstruction<dim> &reconstruction;
-    const DiscreteAction<dim>     &action;
     const SubTriangleBasis<dim>   &basis;
 
     /**

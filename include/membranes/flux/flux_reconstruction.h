@@ -16,6 +16,7 @@
 #include <map>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/dual_mesh/dual_cell_quadrature.h>
+#include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/flux/flux_sub_triangles.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/problem_data.h>
@@ -36,7 +37,7 @@ namespace membranes
    * same sub-triangles.
    *
    * λ_h comes from DiscreteAction::lambda_h(), the dual cells from the
-   * DualCellQuadrature of the DiscreteAction on the pieces K ∩ D_a.
+   * DualCellQuadrature of the Discretization on the pieces K ∩ D_a.
    *
    * <h3>The fluxes t_ih (4.13)</h3>
    * On every sub-triangle κ = (a, m_e, b_K) ⊂ K, t_ih is the lowest order
@@ -130,10 +131,8 @@ namespace membranes
       double balance_defect = 0;
     };
 
-    /** The reconstruction for the discrete action @p action. */
     FluxReconstruction(const Discretization<dim> &discretization,
-                       const ProblemData<dim>    &data,
-                       const DiscreteAction<dim> &action);
+                       const ProblemData<dim>    &data);
 
     /**
      * An edge or a half-edge of the mesh, by the global DoF indices of its
@@ -212,40 +211,39 @@ namespace membranes
                 const BlockVectorType &ghosted_solution);
 
     /**
-     * The defects of the identities for the t_ih of the last reconstruct(),
-     * against the λ_a of the action, with the hanging node constraints
-     * @p hanging_node_constraints and the locally owned DoFs
-     * @p locally_owned_dofs of the DoFHandler of reconstruct(). Only the
-     * output asks for them: the flux estimator does not need them.
+     * The defects of the identities for the t_ih of the last reconstruct()
+     * on @p dof_handler (with its @p hanging_node_constraints), against the
+     * λ_a of @p action and the d_a and loads of @p problem. Only the output
+     * asks for them: the flux estimator does not need them.
      */
     Identities
-    identities(const AffineConstraints<double> &hanging_node_constraints,
-               const IndexSet                  &locally_owned_dofs,
-               const MPI_Comm                   mpi_communicator) const;
+    identities(const DoFHandler<dim>           &dof_handler,
+               const AffineConstraints<double> &hanging_node_constraints,
+               const DiscreteProblem<dim>      &problem,
+               const DiscreteAction<dim>       &action) const;
 
     /**
-     * f_i at the points of DiscreteAction::dual_quadrature() on @p cell, as
+     * f_i at the points of the dual cell quadrature on @p cell, as
      * evaluated by the last reconstruct().
      */
     ArrayView<const double>
     load_values(const CellIterator &cell, const unsigned int i) const;
 
     /**
-     * The sub-mesh S_h as patches for DataOutBase::write_vtu, with
+     * The sub-mesh S_h of the locally owned cells of @p dof_handler (that of
+     * the last reconstruct()) as patches for DataOutBase::write_vtu, with
      * data_names(): on every sub-triangle the vertex a of its dual cell,
-     * λ_h, t_1h, t_2h (exact at the corners: RT0 fields are linear) and
-     * div t_ih.
+     * λ_h (@p lambda_h on the dual cells of @p dual_mesh), t_1h, t_2h
+     * (exact at the corners: RT0 fields are linear) and div t_ih.
      */
     std::vector<DataOutBase::Patch<dim, dim>>
-    patches(const VectorType &lambda_h) const;
+    patches(const DoFHandler<dim> &dof_handler,
+            const DualMesh<dim>   &dual_mesh,
+            const VectorType      &lambda_h) const;
 
     /** The names of the data of patches(), in order. */
     static std::vector<std::string>
     data_names();
-
-    /** The DoFHandler of the last reconstruct(). */
-    const DoFHandler<dim> &
-    get_dof_handler() const;
 
     /** The sub-triangles and their Raviart–Thomas basis. */
     const SubTriangleBasis<dim> &
@@ -276,7 +274,8 @@ namespace membranes
      * the minimization of the half-edge fluxes are returned.
      */
     HalfEdgeMinimization
-    compute_local_fluxes(const BlockVectorType     &ghosted_solution,
+    compute_local_fluxes(const DoFHandler<dim>     &dof_handler,
+                         const BlockVectorType     &ghosted_solution,
                          AlignedVector<PatchTerms> &patch_terms);
 
     /** The worker of compute_local_fluxes() on @p cell. */
@@ -328,7 +327,8 @@ namespace membranes
 
     /** The minimizers: the fluxes of t_ih through the half-edges. */
     void
-    set_half_edge_fluxes(const HalfEdgeMinimization &minimization);
+    set_half_edge_fluxes(const DoFHandler<dim>      &dof_handler,
+                         const HalfEdgeMinimization &minimization);
 
     /** @} */
 
@@ -348,7 +348,8 @@ namespace membranes
 
     /** The DualCellSums of the locally owned cells. */
     DualCellSums
-    dual_cell_sums(const AffineConstraints<double> &hanging_node_constraints,
+    dual_cell_sums(const DoFHandler<dim>           &dof_handler,
+                   const AffineConstraints<double> &hanging_node_constraints,
                    const IndexSet                  &locally_owned_dofs,
                    const MPI_Comm                   mpi_communicator) const;
 
@@ -356,12 +357,9 @@ namespace membranes
 
     const Discretization<dim>     &discretization;
     const ProblemData<dim>        &data;
-    const DiscreteAction<dim>     &action;
     const DualCellQuadrature<dim> &dual_cell_quadrature;
     /** The sub-triangles and their Raviart–Thomas basis. */
     const SubTriangleBasis<dim> basis;
-
-    SmartPointer<const DoFHandler<dim>> dof_handler;
 
     /** By active cell index × sub-triangles per cell + sub-triangle. */
     AlignedVector<SubTriangleData> sub_triangle_data;

@@ -98,6 +98,13 @@ namespace membranes
     SubTriangleBasis(const DualCellQuadrature<dim> &dual,
                      const FiniteElement<dim>      &fe);
 
+    /** The quadrature on the pieces of the dual cells it was built on. */
+    const DualCellQuadrature<dim> &
+    dual_quadrature() const
+    {
+      return dual;
+    }
+
     /** The sub-triangles of the reference cell. */
     const std::vector<typename DualCellQuadrature<dim>::SubTriangle> &
     sub_triangles() const

@@ -10,6 +10,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/problem_data.h>
 #include <utility>
@@ -40,13 +41,15 @@ namespace membranes
   /**
    * The discrete problem (3.4) on one mesh without its contact condition:
    * the Laplacian and the loads of the two membranes on the scalar P1/Q1
-   * space, and the dual cells of the interior vertices. It is built once per
-   * mesh (MembraneProblem::setup_system()) and read, through a const
-   * reference, by everything that works on the mesh: DiscreteAction (the
+   * space, and the vertices V_h that carry λ_a with the measures d_a of
+   * their dual cells. It is built once per mesh
+   * (MembraneProblem::setup_system()) and passed, as a const reference
+   * argument, to everything that works on the mesh: DiscreteAction (the
    * postprocessing (4.5)), the linear systems of the active set method
-   * (CoupledSystem, DecoupledSystem) and the ActiveSet. It holds no
-   * reference to the DoFHandler it was built on; what needs one gets it
-   * from its owner, MembraneProblem.
+   * (CoupledSystem, DecoupledSystem), the ActiveSet and the estimators. It
+   * holds no reference to the DoFHandler it was built on, nor to the
+   * DualMesh it took the interior vertices from; what needs them gets them
+   * from their owner, MembraneProblem.
    *
    * Both membranes live on one mesh with the same scalar element, so their
    * Laplacians are one matrix A and the operator of membrane i is μ_i A.
@@ -111,11 +114,13 @@ namespace membranes
 
     /**
      * Assemble A, the loads and d_a on the mesh of @p dof_handler, with its
-     * hanging node constraints @p hanging_node_constraints, and find V_h.
+     * hanging node constraints @p hanging_node_constraints, and take V_h
+     * from the interior vertices of @p dual_mesh.
      */
     void
     reinit(const DoFHandler<dim>           &dof_handler,
            const AffineConstraints<double> &hanging_node_constraints,
+           const DualMesh<dim>             &dual_mesh,
            const MPI_Comm                   mpi_communicator);
 
     /**
@@ -200,25 +205,6 @@ namespace membranes
     const std::vector<types::global_dof_index> &
     locally_relevant_vertices() const;
 
-    /**
-     * Whether the DoF @p a (locally relevant) belongs to an interior
-     * vertex, of V_h or hanging: the vertices whose dual cells make up ω_h.
-     */
-    bool
-    is_interior_vertex(const types::global_dof_index a) const;
-
-    /**
-     * The same for vertex @p v of the locally relevant @p cell, by the
-     * vertex's index in the mesh: no search (the loops over the cells).
-     */
-    bool
-    is_interior_vertex(
-      const typename DoFHandler<dim>::active_cell_iterator &cell,
-      const unsigned int                                    v) const
-    {
-      return interior_vertex_flags[cell->vertex_index(v)];
-    }
-
   private:
     /**
      * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
@@ -234,7 +220,7 @@ namespace membranes
 
     /** V_h and its data, from the vectors that assemble() fills. */
     void
-    find_vertices(const DoFHandler<dim>           &dof_handler,
+    find_vertices(const DualMesh<dim>             &dual_mesh,
                   const AffineConstraints<double> &hanging_node_constraints,
                   const VectorType                &dual_cell_measure,
                   const VectorType                &stiffness_diagonal);
@@ -259,9 +245,6 @@ namespace membranes
     std::vector<Vertex>                  interior_vertices;
     std::vector<unsigned int>            positions;
     std::vector<types::global_dof_index> relevant_vertices;
-    IndexSet                             interior_vertex_dofs;
-    /** is_interior_vertex() by the index of the vertex in the mesh. */
-    std::vector<char> interior_vertex_flags;
   };
 } // namespace membranes
 

@@ -6,6 +6,7 @@
 #include <deal.II/fe/fe.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/grid/tria.h>
+#include <membranes/dual_mesh/dual_cell_quadrature.h>
 #include <membranes/scene/parameters.h>
 #include <memory>
 
@@ -63,6 +64,15 @@ namespace membranes
     /** Quadrature for the stiffness matrix and the loads (exact for P1/Q1
      * stiffness, degree 3 for smooth loads). */
     const Quadrature<dim> cell_quadrature;
+
+    /**
+     * The quadrature on the pieces K ∩ D_a of the dual cells in every cell
+     * K: the one quadrature of everything that integrates λ_h, which is
+     * constant on each piece (the error norms, both estimators, the flux
+     * reconstruction). It lives on the reference cell, the same for every
+     * mesh of the run.
+     */
+    const DualCellQuadrature<dim> dual_cell_quadrature;
   };
 
 
