@@ -189,11 +189,9 @@ namespace membranes
     // the smaller index between cells of the same level); half of the
     // term goes to each of the two cells, in the copier. (This is what
     // MeshWorker::mesh_loop with assemble_own_interior_faces_once does.
-    // Measured with an FEInterfaceValues face worker on case M, 5.3·10⁵
-    // DoFs: the same estimator to 12 digits, as fast on Q1 (0.84 against
-    // 0.77 s, within the noise) and 1.8 times slower on P1 (1.31 against
-    // 0.72 s), where the jumps of the constant P1 gradients of the cells,
-    // computed once per cell by p1_gradients(), need no FEInterfaceValues;
+    // On P1 the jumps of the constant gradients of the cells, computed once
+    // per cell by p1_gradients(), need no FEInterfaceValues, which is
+    // slower there (benchmarks/README.md, "Choices measured in the code");
     // and on triangles with hanging nodes deal.II 9.4 stops in
     // QProjector::DataSetDescriptor::subface, which knows quadrilaterals
     // only.) Ghost cells take

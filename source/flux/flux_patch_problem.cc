@@ -377,9 +377,8 @@ namespace membranes
    * that the Cholesky factors of A and of the Schur complement B A⁻¹ Bᵀ
    * solve it; should round-off spoil that on a degenerate patch, LU with
    * pivoting does. The factorizations are written out for these systems of
-   * a few dozen unknowns: LAPACKFullMatrix's potrf and potrs in their place
-   * made the flux phase of case M (Q1, 526 338 DoFs) 5 % slower (3.97 s
-   * against 3.77 s) with the same flux estimator.
+   * a few dozen unknowns, on which LAPACK's calls are slower
+   * (benchmarks/README.md, "Choices measured in the code").
    */
   void
   PatchProblem::solve_system()

@@ -64,10 +64,10 @@ namespace membranes
       active_set[dof] = 1;
     active_set.compress(VectorOperation::insert);
 
-    const IndexSet relevant_dofs =
-      DoFTools::extract_locally_relevant_dofs(dof_handler);
-    Fields fields{VectorType(owned_dofs, relevant_dofs, mpi_communicator),
-                  VectorType(owned_dofs, relevant_dofs, mpi_communicator)};
+    // Ghosted, in the layout of the blocks of the solution.
+    Fields fields;
+    fields.w.reinit(ghosted_solution.block(0), true);
+    fields.active_set.reinit(ghosted_solution.block(0), true);
     fields.w          = w;
     fields.active_set = active_set;
     return fields;
