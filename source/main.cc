@@ -12,6 +12,7 @@
  */
 
 #include <algorithm>
+#include <csignal>
 #include <deal.II/base/exceptions.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/multithread_info.h>
@@ -181,6 +182,10 @@ main(int argc, char **argv)
   // (a Gmsh cell that names one vertex twice) that they do not check
   // otherwise.
   deal_II_exceptions::disable_abort_on_exception();
+  // A write beyond the file size limit (ulimit -f) fails with EFBIG, which
+  // write_atomically() reports in one line naming the file, instead of
+  // ending the process by the signal SIGXFSZ, without a word.
+  std::signal(SIGXFSZ, SIG_IGN);
   // The loops over cells outside the linear solver (data, errors,
   // estimators) run on threads: as many per process as there are cores
   // per process on the node (deal.II's default; DEAL_II_NUM_THREADS limits

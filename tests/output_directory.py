@@ -17,6 +17,9 @@ SCENES is the directory of the shipped scenes; CASE one of
 - kill: a run killed (SIGKILL) once it has written two cycles does not
   block the next run on its directory, which leaves no file of the killed
   one.
+- kill_mpi: the same with one process of a run on two (MPI_LAUNCHER) killed,
+  the one that does not hold the directory: the launcher ends the run (no
+  process waits for the killed one) with a non-zero exit status.
 - reproduce: the parameters.prm of a run (a scene with a relative mesh
   file, settings from the command line) makes the same run, as another
   directory (--set Output/Directory) and, after it ended, in its own
@@ -32,19 +35,14 @@ import subprocess
 import sys
 import time
 
+from checks import check, failures
+
 # A run of the race and kill cases: case M on quadrilaterals, 7 cycles,
 # about 5 s on one core (the 7th cycle alone takes 3.5 s).
 LONG_RUN = ["--set", "Refinement/Cycles=7"]
 TIMEOUT = 120
-
-failures = []
-
-
-def check(ok, what):
-    print("%s %s" % ("PASS" if ok else "FAIL", what), flush=True)
-    if not ok:
-        failures.append(what)
-    return ok
+# Seconds within which the launcher ends a job of which one process died.
+KILLED_JOB_TIMEOUT = 20
 
 
 def start(command, cwd=None):
@@ -184,6 +182,21 @@ def rerun(membranes, scenes, workdir, launcher):
         check(f.read().count("<DataSet") == 2, "solution.pvd lists 2 cycles")
 
 
+def next_run_after_kill(membranes, scene, outdir):
+    """The next run on the directory of a killed run completes and leaves
+    no file of the killed one."""
+    print("left by the killed run: %s" % sorted(listing(outdir)))
+    second = run([membranes, "--set", "Output/Directory=" + outdir,
+                  "--set", "Refinement/Cycles=1", scene])
+    check(second.returncode == 0 and not second.stderr,
+          "the next run completes: %r" % second.stderr)
+    expected = {"solution-00.vtu", "solution.pvd", "report.csv",
+                "parameters.prm", "run-info.txt", ".membranes-lock"}
+    check(listing(outdir) == expected, "the directory holds the next run's "
+          "files only: %s" % sorted(listing(outdir)))
+    check(len(report_rows(outdir)) == 1, "report.csv has 1 row")
+
+
 def kill(membranes, scenes, workdir, launcher):
     outdir = os.path.join(workdir, "kill")
     scene = os.path.join(scenes, "case-m-quadrilateral.prm")
@@ -195,17 +208,69 @@ def kill(membranes, scenes, workdir, launcher):
     first.send_signal(signal.SIGKILL)
     first.wait(timeout=TIMEOUT)
     check(first.returncode == -signal.SIGKILL, "the first run is killed")
-    killed = listing(outdir)
-    print("left by the killed run: %s" % sorted(killed))
-    second = run([membranes, "--set", "Output/Directory=" + outdir,
-                  "--set", "Refinement/Cycles=1", scene])
-    check(second.returncode == 0 and not second.stderr,
-          "the next run completes: %r" % second.stderr)
-    expected = {"solution-00.vtu", "solution.pvd", "report.csv",
-                "parameters.prm", "run-info.txt", ".membranes-lock"}
-    check(listing(outdir) == expected, "the directory holds the next run's "
-          "files only: %s" % sorted(listing(outdir)))
-    check(len(report_rows(outdir)) == 1, "report.csv has 1 row")
+    next_run_after_kill(membranes, scene, outdir)
+
+
+def ranks(launcher_pid):
+    """The processes that the launcher launcher_pid started, by their MPI
+    rank (read from their environment): rank -> pid."""
+    found, parents = {}, [launcher_pid]
+    while parents:
+        parent = parents.pop()
+        with open("/proc/%d/task/%d/children" % (parent, parent)) as f:
+            children = [int(pid) for pid in f.read().split()]
+        parents += children
+        for pid in children:
+            with open("/proc/%d/environ" % pid, "rb") as f:
+                variables = dict(v.split(b"=", 1)
+                                 for v in f.read().split(b"\0") if b"=" in v)
+            rank = variables.get(b"OMPI_COMM_WORLD_RANK",
+                                 variables.get(b"PMI_RANK"))
+            if rank is not None:
+                found[int(rank)] = pid
+    return found
+
+
+def ended(pid):
+    """Whether the process pid ends (or is a zombie) within
+    KILLED_JOB_TIMEOUT."""
+    deadline = time.time() + KILLED_JOB_TIMEOUT
+    while time.time() < deadline:
+        try:
+            with open("/proc/%d/stat" % pid) as f:
+                if f.read().rsplit(")", 1)[1].split()[0] == "Z":
+                    return True
+        except FileNotFoundError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def kill_mpi(membranes, scenes, workdir, launcher):
+    outdir = os.path.join(workdir, "kill-mpi")
+    scene = os.path.join(scenes, "case-m-quadrilateral.prm")
+    first = start(launcher.split() + [
+        "2", membranes, "--set", "Output/Directory=" + outdir,
+        "--set", "Output/Write nodal values=true"] + LONG_RUN + [scene])
+    check(wait_for(lambda: len(report_rows(outdir)) >= 2, first),
+          "the first run, on two processes, writes 2 rows")
+    processes = ranks(first.pid)
+    if not check(sorted(processes) == [0, 1],
+                 "the launcher runs ranks 0 and 1: %s" % processes):
+        first.kill()
+        return
+    os.kill(processes[1], signal.SIGKILL)
+    try:
+        first.wait(timeout=KILLED_JOB_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        first.kill()
+        os.kill(processes[0], signal.SIGKILL)
+        first.wait()
+    check(first.returncode != 0, "the launcher ends within %d s of the "
+          "kill of rank 1, with exit status %d (not 0)"
+          % (KILLED_JOB_TIMEOUT, first.returncode))
+    check(ended(processes[0]), "rank 0 ends")
+    next_run_after_kill(membranes, scene, outdir)
 
 
 def same_reports(a, b, what):
@@ -275,7 +340,8 @@ def reproduce(membranes, scenes, workdir, launcher):
     same_reports(kept, original, "its own directory")
 
 
-CASES = {"race": race, "rerun": rerun, "kill": kill, "reproduce": reproduce}
+CASES = {"race": race, "rerun": rerun, "kill": kill, "kill_mpi": kill_mpi,
+         "reproduce": reproduce}
 
 
 def main():

@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <cerrno>
-#include <cstring>
 #include <deal.II/base/mpi.h>
 #include <exception>
 #include <fcntl.h>
@@ -216,9 +215,6 @@ namespace membranes
   {
     created                     = create_directory(directory);
     const std::string lock_path = directory + "/" + lock_name;
-    const auto        refused   = [this](const std::string &why) {
-      return Parameters::invalid_entry("Output/Directory", directory, why);
-    };
     // A failing run that made the directory removes the lock file while it
     // holds it (see the destructor): a lock taken on the file that another
     // process opened before is on a file without a name, and is taken anew.
@@ -227,8 +223,7 @@ namespace membranes
         const int file =
           ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
         if (file < 0)
-          throw refused("cannot open its lock file " + lock_name + " (" +
-                        std::strerror(errno) + ")");
+          throw file_error("open", lock_path, errno);
         if (::flock(file, LOCK_EX | LOCK_NB) != 0)
           {
             const int         reason = errno;
@@ -239,8 +234,7 @@ namespace membranes
                 "Output/Directory = '" + directory +
                 "' is in use by another run" +
                 (holder.empty() ? "" : " (" + holder + ")"));
-            throw refused("cannot lock its lock file " + lock_name + " (" +
-                          std::strerror(reason) + ")");
+            throw file_error("lock", lock_path, reason);
           }
         struct stat locked, named;
         if (::fstat(file, &locked) == 0 &&
@@ -255,14 +249,15 @@ namespace membranes
               "process " + std::to_string(::getpid()) + " on " + host;
             if (::ftruncate(file, 0) != 0 ||
                 ::pwrite(file, holder.data(), holder.size(), 0) < 0)
-              throw refused("cannot write its lock file " + lock_name + " (" +
-                            std::strerror(errno) + ")");
+              throw file_error("write", lock_path, errno);
             return;
           }
         ::close(file);
       }
-    throw refused("cannot lock it: its lock file " + lock_name +
-                  " keeps being replaced");
+    throw Parameters::invalid_entry("Output/Directory",
+                                    directory,
+                                    "cannot lock it: its lock file " +
+                                      lock_name + " keeps being replaced");
   }
 
 

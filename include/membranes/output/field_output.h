@@ -19,8 +19,9 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * Field output, each file to a temporary name and renamed, so
-   * that no half-written file is left:
+   * Field output, each file by write_atomically(), so that no half-written
+   * file is left, and a file that cannot be written is an error naming it
+   * and the system's reason:
    * - for ParaView (`Write vtu`), one VTU file per cycle with u1, u2,
    *   w = u1 − u2, λ_h (the nodal values λ_a of (4.5) at the vertices of
    *   V_h, zero at the others), the active set indicator (1 at the active

@@ -95,7 +95,8 @@ namespace membranes
   private:
     /**
      * Create the directory if missing and take the lock on its lock file;
-     * an InputError if another process holds it.
+     * an InputError if another process holds it, the file_error() of a
+     * step that the system refuses.
      */
     void
     lock();

@@ -136,8 +136,10 @@ namespace membranes
 
   /**
    * The report of a run: report.csv with one row per cycle,
-   * rewritten after every cycle (to a temporary name, then renamed, so that
-   * a stopped run never leaves a half-written file), and at the end the
+   * rewritten after every cycle by write_atomically() (a stopped run never
+   * leaves a half-written file; one that cannot be written is an error
+   * naming it and the system's reason, and the last complete report.csv
+   * stays), and at the end the
    * same numbers as a deal.II ConvergenceTable with observed rates in h
    * (h ~ DoFs^{-1/2}) on the terminal.
    *
