@@ -1,8 +1,6 @@
 #include <algorithm>
 #include <deal.II/base/mpi.h>
-#include <deal.II/distributed/grid_refinement.h>
 #include <deal.II/dofs/dof_tools.h>
-#include <deal.II/grid/grid_refinement.h>
 #include <limits>
 #include <map>
 #include <membranes/estimators/error_estimator.h>
@@ -10,6 +8,7 @@
 #include <membranes/flux/flux_equilibration.h>
 #include <membranes/flux/flux_reconstruction.h>
 #include <membranes/membrane_problem.h>
+#include <membranes/mesh/cell_marking.h>
 
 namespace membranes
 {
@@ -474,13 +473,13 @@ namespace membranes
    * SolutionTransfer first, to be interpolated onto the new mesh by
    * transfer_solution().
    *
-   * A p4est mesh is marked by deal.II's parallel functions, which find the
-   * thresholds by a global bisection. A mesh that every process holds whole
-   * (triangles, on a parallel::shared::Triangulation) is marked by the
-   * serial functions on every process, with the indicators of all cells:
-   * each process contributes those of its own cells (the others are zero)
-   * and the sum is the same vector everywhere, so every process flags the
-   * same cells, the ones that one process would flag.
+   * mark_cells() finds the thresholds from all indicators, sorted, so that
+   * any number of processes marks the same cells, also where indicators
+   * tie. A mesh that every process holds whole (triangles, on a
+   * parallel::shared::Triangulation) is flagged on every process, with the
+   * indicators of all cells: each process contributes those of its own
+   * cells (the others are zero) and the sum is the same vector everywhere,
+   * so every process flags the same cells.
    */
   template <int dim>
   void
@@ -498,42 +497,16 @@ namespace membranes
             indicators[cell->active_cell_index()] = 0;
         Utilities::MPI::sum(indicators, mpi_communicator, indicators);
       }
-    // Flags the cells by a share @p top at the large end of the indicators
-    // and @p bottom at the small end, of η² (bulk) or of the cells; on
-    // several processes the thresholds are found by a global bisection
-    // instead of a global sort.
-    const auto mark = [&](const Parameters::Marking marking,
-                          const double              top,
-                          const double              bottom) {
-      const bool bulk = (marking == Parameters::Marking::bulk);
-      if (distributed_triangulation && bulk)
-        parallel::distributed::GridRefinement::
-          refine_and_coarsen_fixed_fraction(*distributed_triangulation,
-                                            indicators,
-                                            top,
-                                            bottom);
-      else if (distributed_triangulation)
-        parallel::distributed::GridRefinement::refine_and_coarsen_fixed_number(
-          *distributed_triangulation, indicators, top, bottom);
-      else if (bulk)
-        GridRefinement::refine_and_coarsen_fixed_fraction(*triangulation,
-                                                          indicators,
-                                                          top,
-                                                          bottom);
-      else
-        GridRefinement::refine_and_coarsen_fixed_number(*triangulation,
-                                                        indicators,
-                                                        top,
-                                                        bottom);
-    };
-
     if (refinement.strategy == Parameters::RefinementStrategy::global)
       triangulation->set_all_refine_flags();
     else
       {
-        mark(refinement.marking,
-             refinement.bulk_parameter,
-             refinement.coarsen_fraction);
+        mark_cells(*triangulation,
+                   indicators,
+                   refinement.marking,
+                   refinement.bulk_parameter,
+                   refinement.coarsen_fraction,
+                   mpi_communicator);
         const double least_share =
           (refinement.minimum_growth - 1) /
           (GeometryInfo<dim>::max_children_per_cell - 1);
@@ -543,7 +516,12 @@ namespace membranes
             ++n_marked;
         if (Utilities::MPI::sum(n_marked, mpi_communicator) <
             least_share * triangulation->n_global_active_cells())
-          mark(Parameters::Marking::fixed_fraction, least_share, 0);
+          mark_cells(*triangulation,
+                     indicators,
+                     Parameters::Marking::fixed_fraction,
+                     least_share,
+                     0,
+                     mpi_communicator);
       }
     triangulation->prepare_coarsening_and_refinement();
 
