@@ -322,7 +322,7 @@ namespace membranes::Parameters
       selection(linear_solvers),
       "direct: sparse LU (Trilinos Amesos MUMPS), any number of "
       "processes; cg-amg: CG with Trilinos ML AMG; auto: "
-      "direct for small problems on one process.");
+      "direct up to 1000 unknowns on one process, cg-amg above.");
     prm.declare_entry("Tolerance",
                       "1e-10",
                       Double(1e-15, 1e-2),
