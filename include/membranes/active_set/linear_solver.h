@@ -60,12 +60,11 @@ namespace membranes
     static constexpr const char *direct_solver_package = "Amesos_Mumps";
 
     /**
-     * Largest problem that `auto` hands to the direct solver. Measured on
-     * the scalar problems of the decoupled method, adaptive and uniform,
-     * Q1 and P1 (benchmarks/solver_crossover.py): CG with AMG is faster on
-     * every mesh from 700 to 1 300 unknowns on, and three to six times
-     * faster at 10⁴ (the direct solver factorizes the matrix of w at every
-     * active set iteration); below, either takes a few milliseconds.
+     * Largest problem that `auto` hands to the direct solver: on the scalar
+     * problems of the decoupled method, adaptive and uniform, Q1 and P1,
+     * CG with AMG is the faster from about a thousand unknowns on, since
+     * the direct solver factorizes the matrix of w at every active set
+     * iteration (benchmarks/README.md, `solver_crossover.py`).
      */
     static constexpr types::global_dof_index direct_solver_dof_limit = 1000;
 

@@ -28,13 +28,11 @@ namespace membranes
    * The indicators differ slightly between runs on different numbers of
    * processes: the linear algebra sums in another order, and CG with a
    * preconditioner built on another partition stops at another iterate
-   * within the algebraic error that `Solver/Tolerance` allows (with the
-   * default 10⁻¹⁰, estimators differ by up to 4·10⁻⁸ relative; with the
-   * direct solver by round-off, 10⁻¹¹). On a symmetric scene many cells carry
-   * indicators that are equal in exact arithmetic, and a marking that cuts
-   * through such a group by the order of their computed values would pick
-   * different cells of it on different partitions, and from then on build
-   * different meshes. Here the thresholds are made independent of the
+   * within the algebraic error that `Solver/Tolerance` allows. On a
+   * symmetric scene many cells carry indicators that are equal in exact
+   * arithmetic, and a marking that cuts through such a group by the order
+   * of their computed values would pick different cells of it on
+   * different partitions, and from then on build different meshes. Here the thresholds are made independent of the
    * partition, and the cut cannot fall inside a group of ties:
    *
    * - one process gathers the indicators of all cells, sorts them, and
@@ -46,11 +44,10 @@ namespace membranes
    *   a cell is refined if η_K² ≥ (1 − 10⁻⁶) t, t the smallest indicator
    *   of the share, and coarsened if η_K² ≤ (1 + 10⁻⁶) b. Indicators that
    *   agree to a relative 10⁻⁶, far above their differences between
-   *   partitions, are so marked together or not at all. (10⁻¹⁰ is not
-   *   enough: with CG, ties on case M were split from cycle 6 on.) A cell
-   *   whose indicator is not tied to t but lies within 10⁻⁶ below it is
-   *   refined too, which changes the marked share by a few cells at
-   *   most.
+   *   partitions (benchmarks/README.md, `process_count.py`), are so
+   *   marked together or not at all. A cell whose indicator is not tied
+   *   to t but lies within 10⁻⁶ below it is refined too, which changes
+   *   the marked share by a few cells at most.
    *
    * Gathering the indicators costs one double per cell on the first process
    * and a sort, a small part of a cycle.
