@@ -17,9 +17,13 @@ it is present and non-empty; ``--columns`` names the columns to plot instead
 column must hold drawable values in at least one report, and every report in
 at least one named column.  Each quantity has its own colour, each report
 file its own marker and line style; a file is labelled by LABEL if given,
-otherwise by the name of the directory containing it.  The left panel also
-shows reference slopes N^{-1/2} ~ O(h) and N^{-1} ~ O(h^2) (two dimensions,
-so h ~ N^{-1/2}).
+otherwise by the name of the directory containing it.  Quantities whose
+values coincide in every report (e.g. ``err_lambda_L2`` and
+``err_lambda_L2_omega_h`` when lambda vanishes near the boundary) are drawn
+once, and the legend names them together (``a = b``).  The left panel also
+shows reference slopes N^{-1/2} and N^{-1} (in two dimensions h ~ N^{-1/2},
+so these are the orders h and h^2).  The legend sits below the panels,
+outside the data.
 
 The figure is written to PREFIX.png (and PREFIX.svg with ``--svg``); the
 default PREFIX is ``convergence`` in the directory of the first file.  The
@@ -44,8 +48,10 @@ ESTIMATOR = "estimator"
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<", ">", "*"]
 LINE_STYLES = ["-", "--", ":", "-."]
 # (exponent of N, legend label, dash pattern) of the reference slopes.
-REFERENCE_SLOPES = [(-0.5, r"$O(h)$", (0, (6, 3))),
-                    (-1.0, r"$O(h^2)$", (0, (2, 2)))]
+REFERENCE_SLOPES = [(-0.5, r"$N^{-1/2}$", (0, (6, 3))),
+                    (-1.0, r"$N^{-1}$", (0, (2, 2)))]
+# Relative difference up to which two quantities coincide.
+COINCIDENCE = 1e-12
 
 
 class PlotError(Exception):
@@ -186,6 +192,35 @@ def quantity_order(series_list, selection=None):
                                            found.index(name)))
 
 
+def coincide(series_list, first, second):
+    """Whether two columns hold the same values in every report."""
+    for series in series_list:
+        a, b = series.columns.get(first), series.columns.get(second)
+        if a is None or b is None or len(a) != len(b):
+            return False
+        for x, y in zip(a, b):
+            if (x is None) != (y is None):
+                return False
+            if x is not None and abs(x - y) > COINCIDENCE * max(abs(x),
+                                                                 abs(y)):
+                return False
+    return True
+
+
+def merge_coinciding(series_list, quantities):
+    """The quantities to draw, each with its legend label: a quantity that
+    coincides with an earlier one is not drawn again, and joins its label."""
+    labels = {}
+    for name in quantities:
+        twin = next((kept for kept in labels
+                     if coincide(series_list, kept, name)), None)
+        if twin is None:
+            labels[name] = name
+        else:
+            labels[twin] += " = " + name
+    return labels
+
+
 def plot_panel(axes, series_list, colours, x_name, x_label):
     """Draw every quantity of every file against one x column."""
     for index, series in enumerate(series_list):
@@ -222,11 +257,11 @@ def add_reference_slopes(axes, series_list, quantities):
     return handles
 
 
-def legend_handles(series_list, colours):
+def legend_handles(series_list, colours, labels):
     """Proxy artists: one per quantity (colour), one per file (style)."""
     from matplotlib.lines import Line2D
 
-    quantity_handles = [Line2D([], [], color=colour, label=name)
+    quantity_handles = [Line2D([], [], color=colour, label=labels[name])
                         for name, colour in colours.items()]
     file_handles = [Line2D([], [], color="grey",
                            marker=MARKERS[index % len(MARKERS)],
@@ -243,7 +278,9 @@ def make_figure(series_list, title, selection=None):
     matplotlib.use("Agg")
     from matplotlib import pyplot
 
-    quantities = quantity_order(series_list, selection)
+    labels = merge_coinciding(series_list,
+                              quantity_order(series_list, selection))
+    quantities = list(labels)
     palette = pyplot.rcParams["axes.prop_cycle"].by_key()["color"]
     colours = {name: palette[index % len(palette)]
                for index, name in enumerate(quantities)}
@@ -254,13 +291,17 @@ def make_figure(series_list, title, selection=None):
                "cumulative wall time of the method [s] (without error norms)")
     slopes = add_reference_slopes(left, series_list, quantities)
 
-    quantity_handles, file_handles = legend_handles(series_list, colours)
-    left.legend(handles=quantity_handles + slopes, fontsize="small",
-                title="quantity")
-    right.legend(handles=file_handles, fontsize="small", title="report")
+    quantity_handles, file_handles = legend_handles(series_list, colours,
+                                                    labels)
+    handles = quantity_handles + slopes + file_handles
+    columns = min(4, len(handles))
+    rows = -(-len(handles) // columns)
+    figure.legend(handles=handles, fontsize="small", ncol=columns,
+                  loc="lower center", frameon=False)
     if title:
         figure.suptitle(title)
-    figure.tight_layout()
+    # Room below the panels for the legend, a line of text per row.
+    figure.tight_layout(rect=(0, 0.045 * rows + 0.02, 1, 1))
     return figure
 
 
