@@ -47,24 +47,5 @@ echo "== load average $(cut -d' ' -f1-3 /proc/loadavg) at end"
 echo "== medians of $runs runs"
 
 # The tables of the first run with every number replaced by the median of
-# that cell over the runs, with as many decimals as the first run prints.
-python3 - "$out"/run*.md <<'PYTHON' | tee "$out/medians.md"
-import statistics
-import sys
-
-runs = [open(name).read().splitlines() for name in sys.argv[1:]]
-for k, line in enumerate(runs[0]):
-    if not line.startswith("| "):
-        print(line)
-        continue
-    cells = [run[k].strip("|").split(" | ") for run in runs]
-    row = []
-    for c, text in enumerate(cells[0]):
-        try:
-            value = statistics.median(float(cell[c]) for cell in cells)
-            decimals = len(text.strip().split(".")[1]) if "." in text else 0
-            row.append(f"{value:.{decimals}f}")
-        except ValueError:
-            row.append(text.strip())
-    print("| " + " | ".join(row) + " |")
-PYTHON
+# that cell over the runs.
+python3 "$root/benchmarks/median_tables.py" "$out"/run*.md | tee "$out/medians.md"

@@ -49,22 +49,4 @@ echo "== medians of $runs runs"
 
 # The tables of the first run with every number replaced by the median of
 # that cell over the runs.
-python3 - "$out"/run*.md <<'PYTHON' | tee "$out/medians.md"
-import statistics
-import sys
-
-runs = [open(name).read().splitlines() for name in sys.argv[1:]]
-for k, line in enumerate(runs[0]):
-    if not line.startswith("| ") or line.startswith("| step |"):
-        print(line)
-        continue
-    cells = [run[k].strip("|").split(" | ") for run in runs]
-    row = []
-    for c, text in enumerate(cells[0]):
-        try:
-            value = statistics.median(float(cell[c]) for cell in cells)
-            row.append(f"{value:.3f}" if "." in text else f"{value:.0f}")
-        except ValueError:
-            row.append(text.strip())
-    print("| " + " | ".join(row) + " |")
-PYTHON
+python3 "$root/benchmarks/median_tables.py" "$out"/run*.md | tee "$out/medians.md"

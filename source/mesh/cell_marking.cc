@@ -3,6 +3,7 @@
 #include <functional>
 #include <limits>
 #include <membranes/mesh/cell_marking.h>
+#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -11,44 +12,32 @@ namespace membranes
   namespace
   {
     /**
-     * The number of indicators of @p sorted (in decreasing order) that a
-     * share @p fraction takes from its large end: of the sum (bulk, the
-     * fewest whose sum reaches the share) or of the count.
+     * The number of indicators, from @p first on, that a share @p fraction
+     * takes of the sorted range [@p first, @p last): of the sum (bulk, the
+     * fewest whose sum reaches the share) or of the count. With reverse
+     * iterators, the same from the small end.
      */
+    template <typename Iterator>
     std::size_t
-    share_from_top(const std::vector<double> &sorted,
-                   const Parameters::Marking  marking,
-                   const double               fraction)
+    share(const Iterator            first,
+          const Iterator            last,
+          const Parameters::Marking marking,
+          const double              fraction)
     {
+      const std::size_t size = last - first;
       if (fraction <= 0)
         return 0;
       if (marking == Parameters::Marking::fixed_fraction)
-        return static_cast<std::size_t>(fraction * sorted.size());
-      double total = 0;
-      for (const double value : sorted)
-        total += value;
+        return static_cast<std::size_t>(fraction * size);
+      const double total = std::accumulate(first, last, 0.);
       if (total == 0)
         return 0;
       std::size_t n   = 0;
       double      sum = 0;
-      while (sum < fraction * total && n < sorted.size())
-        sum += sorted[n++];
+      for (Iterator value = first; sum < fraction * total && value != last;
+           ++value, ++n)
+        sum += *value;
       return n;
-    }
-
-
-
-    /**
-     * The same from the small end of @p sorted, with the sum taken from
-     * there.
-     */
-    std::size_t
-    share_from_bottom(const std::vector<double> &sorted,
-                      const Parameters::Marking  marking,
-                      const double               fraction)
-    {
-      std::vector<double> reversed(sorted.rbegin(), sorted.rend());
-      return share_from_top(reversed, marking, fraction);
     }
   } // namespace
 
@@ -82,9 +71,10 @@ namespace membranes
         for (const auto &values : gathered)
           sorted.insert(sorted.end(), values.begin(), values.end());
         std::sort(sorted.begin(), sorted.end(), std::greater<double>());
-        const std::size_t n_refine = share_from_top(sorted, marking, top);
+        const std::size_t n_refine =
+          share(sorted.begin(), sorted.end(), marking, top);
         const std::size_t n_coarsen =
-          share_from_bottom(sorted, marking, bottom);
+          share(sorted.rbegin(), sorted.rend(), marking, bottom);
         if (n_refine > 0 && sorted[n_refine - 1] > 0)
           thresholds.first = (1 - tie_tolerance) * sorted[n_refine - 1];
         else if (n_refine > 0)

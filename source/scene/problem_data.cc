@@ -584,9 +584,12 @@ namespace membranes
         return;
       }
 
-    // Per point f1, f2; with manufactured data u1, Δu1, u2, Δu2, λ.
+    // Per point f1, f2; with manufactured data u1, Δu1, u2, Δu2, λ, of
+    // which the loads need Δu_i (at laplacian_slot[i]) and λ.
     static_assert(sizeof(Point<dim>) == dim * sizeof(double));
-    const unsigned int n_values = manufactured ? 5 : 2;
+    constexpr std::array<unsigned int, 2> laplacian_slot{{1, 3}};
+    constexpr unsigned int                lambda_slot = 4;
+    const unsigned int                    n_values    = manufactured ? 5 : 2;
     values.group_values.resize(n_points * n_values);
     loads_group(&points[0][0], n_points, values.group_values.data());
     for (unsigned int q = 0; q < n_points; ++q)
@@ -597,8 +600,8 @@ namespace membranes
             values.f[i][q] = manufactured ?
                                manufactured_load(i,
                                                  mu[i],
-                                                 group_value[2 * i + 1],
-                                                 group_value[4]) :
+                                                 group_value[laplacian_slot[i]],
+                                                 group_value[lambda_slot]) :
                                group_value[i];
             f[i]->check(values.f[i][q], points[q]);
           }
