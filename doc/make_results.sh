@@ -109,16 +109,20 @@ membranes_run() {
 }
 
 # block DOCUMENT NAME < TABLE: the table between the markers NAME of
-# DOCUMENT. In README.md and benchmarks/README.md below the list of commands
-# run since the last block ("Made by"); the documents of doc/ teach and hold
-# the table alone, their commands are collected in doc_commands for the
-# block tutorial-runs of benchmarks/README.md.
+# DOCUMENT. In benchmarks/README.md below the list of commands run since the
+# last block ("Made by"); README.md and the documents of doc/ teach and hold
+# the table alone, their commands are collected in readme_commands and
+# doc_commands for the blocks readme-runs and tutorial-runs of
+# benchmarks/README.md.
 doc_commands=()
+readme_commands=()
 block() {
   local document=$1 name=$2 file="$work/blocks/$2.md" line
   {
     if [[ $document == doc/* ]]; then
       doc_commands+=("${commands[@]}")
+    elif [[ $document == README.md ]]; then
+      readme_commands+=("${commands[@]}")
     else
       echo "Made by"
       echo
@@ -131,6 +135,21 @@ block() {
   } >"$file"
   $python doc/results.py splice "$document" "$name" "$file"
   echo "  -> $document: $name"
+}
+
+# command_block NAME COMMAND...: the commands as a shell block between the
+# markers NAME of benchmarks/README.md.
+command_block() {
+  local name=$1 line
+  shift
+  {
+    echo '```sh'
+    for line in "$@"; do echo "$line"; done
+    echo '```'
+  } >"$work/blocks/$name.md"
+  $python doc/results.py splice benchmarks/README.md "$name" \
+    "$work/blocks/$name.md"
+  echo "  -> benchmarks/README.md: $name"
 }
 
 # figure SOURCE IMAGE: copy a figure into doc/images/.
@@ -175,8 +194,9 @@ for section in $sections; do
     run $python source/plot_report.py "$work/default/report.csv" \
       --output "$work/default/convergence"
     figure "$work/default/convergence.png" default-convergence.png
-    $python doc/results.py summary "$work/default/report.csv" |
-      block README.md default
+    $python doc/results.py summary "$work/default/report.csv" \
+      >"$work/blocks/default.table"
+    block README.md default <"$work/blocks/default.table"
 
     commands=()
     run "$membranes" --set "Output/Directory=$work/own-scene" \
@@ -190,6 +210,8 @@ for section in $sections; do
       "$work/own-scene/report.csv=adaptive" \
       "$work/own-scene-uniform/report.csv=uniform" >"$work/blocks/own-scene.table"
     block README.md own-scene <"$work/blocks/own-scene.table"
+    # What made them, in benchmarks/README.md.
+    command_block readme-runs "${readme_commands[@]}"
     ;;
 
   tutorial)
@@ -274,14 +296,7 @@ for section in $sections; do
     done
 
     # What made the tables and figures of doc/, in benchmarks/README.md.
-    {
-      echo '```sh'
-      for line in "${doc_commands[@]}"; do echo "$line"; done
-      echo '```'
-    } >"$work/blocks/tutorial-runs.md"
-    $python doc/results.py splice benchmarks/README.md tutorial-runs \
-      "$work/blocks/tutorial-runs.md"
-    echo "  -> benchmarks/README.md: tutorial-runs"
+    command_block tutorial-runs "${doc_commands[@]}"
     ;;
 
   *)
