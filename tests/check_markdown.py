@@ -18,11 +18,14 @@ directory of this script):
   have balanced math: every ``$`` that opens inline math closes in the same
   paragraph, every ``$$`` that opens display math closes before the end of
   the file, and no single ``$`` stands inside display math. ``\\$`` and the
-  contents of code spans and fenced code blocks do not count. Inside inline
-  math there is no backslash before ``{ } | , ! ;``: GitHub's Markdown
-  removes it before the math is typeset (``\\{`` renders as ``{``, ``\\|``
-  as ``|``); ``\\lbrace``, ``\\rbrace``, ``\\Vert`` and ``\\vert`` render,
-  and a thin space is not needed.
+  contents of code spans and fenced code blocks do not count. Inside ``$``
+  and ``$$`` math there is no backslash before an ASCII punctuation
+  character: GitHub's Markdown removes it before the math is typeset
+  (``\\{`` renders as ``{``, ``\\|`` as ``|``, ``\\,`` as ``,``, and
+  ``\\\\`` as ``\\``, which joins the rows of ``aligned``). In inline math
+  ``\\lbrace``, ``\\rbrace``, ``\\Vert`` and ``\\vert`` render; display
+  math belongs in a ```` ```math ```` fence, which GitHub hands to the
+  renderer as written.
 
 With FILE arguments, both checks apply to each FILE (to try the checks on a
 file of one's own).
@@ -41,8 +44,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f\x80-\x9f]")
 FENCE = re.compile(r"^ {0,3}(`{3,}|~{3,})")
-# What GitHub's Markdown unescapes inside inline math.
-ESCAPED = tuple("{}|,!;")
+# What GitHub's Markdown unescapes inside math: a backslash before any ASCII
+# punctuation character (the backslash escapes of CommonMark).
+ESCAPED = tuple("!\"#$%&'()*+,-./:;<=>?@[\\]^_`{|}~")
 
 
 def markdown_files():
@@ -120,11 +124,15 @@ def unbalanced_math(name, text):
                 i += 2
                 continue
             if c == "\\" and (inline is not None or display is not None):
-                if inline is not None and line[i + 1:i + 2] in ESCAPED:
-                    defects.append(f"{name}:{number}: '\\{line[i + 1]}' in "
-                                   "inline math: GitHub drops the "
-                                   "backslash (use \\lbrace, \\rbrace, "
-                                   "\\Vert, \\vert, or no thin space)")
+                escaped = line[i + 1:i + 2]
+                if escaped and escaped in ESCAPED:
+                    defects.append(
+                        f"{name}:{number}: '\\{escaped}' in "
+                        + ("inline math: GitHub drops the backslash (use "
+                           "\\lbrace, \\rbrace, \\Vert, \\vert, or no "
+                           "thin space)" if inline is not None else
+                           "display math: GitHub drops the backslash (write "
+                           "the formula in a ```math fence)"))
                 i += 2
                 continue
             if c == "`" and inline is None and display is None:
