@@ -616,51 +616,99 @@ namespace membranes
 
 
 
+  /**
+   * Whether the mesh just set up has more DoFs than `Refinement/Max dofs`
+   * allows: an error on the first mesh, the end of the run on a later one.
+   */
+  template <int dim>
+  bool
+  MembraneProblem<dim>::exceeds_max_dofs(const unsigned int cycle) const
+  {
+    const types::global_dof_index n_dofs   = solution.size();
+    const auto                    max_dofs = parameters.refinement.max_dofs;
+    if (max_dofs == 0 || n_dofs <= max_dofs)
+      return false;
+    if (cycle == 0)
+      throw Parameters::invalid_entry("Refinement/Max dofs",
+                                      std::to_string(max_dofs),
+                                      "the first mesh already has " +
+                                        std::to_string(n_dofs) + " DoFs");
+    pcout << "Stopping: the next mesh would have " << n_dofs
+          << " DoFs > Max dofs = " << max_dofs << std::endl;
+    return true;
+  }
+
+
+
+  /**
+   * The mesh of the cycle into its record, and the first line of its
+   * progress output. The DoFs are those of the pair (u1h, u2h): both
+   * blocks of the solution.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::record_mesh(const unsigned int cycle)
+  {
+    record.mesh = {cycle,
+                   triangulation->n_global_active_cells(),
+                   triangulation->n_global_levels(),
+                   static_cast<types::global_dof_index>(solution.size())};
+    pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
+          << record.mesh.dofs << " DoFs";
+    if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
+      pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
+            << " processes";
+    pcout << std::endl;
+  }
+
+
+
+  /**
+   * The costs of the cycle into its record (the times of its phases, the
+   * cumulative time of the run, the peak memory summed over the processes),
+   * and the last line of its progress output.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::record_costs()
+  {
+    record.times = phase_times();
+    record.cumulative_wall_time =
+      previous_record.cumulative_wall_time + record.times.method();
+    Utilities::System::MemoryStats memory;
+    Utilities::System::get_memory_stats(memory);
+    record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
+    record.memory_mb =
+      Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
+    pcout << "   " << record.solve.active_set_iterations
+          << " active set iterations, " << record.solve.active_vertices
+          << " active vertices, " << record.times.method() << " s" << std::endl;
+  }
+
+
+
   template <int dim>
   void
   MembraneProblem<dim>::run()
   {
     make_grid();
     output_directory.claim();
-    double cumulative_time = 0;
     for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
       {
         record = CycleRecord();
-
         computing_timer.reset();
-        TimerOutput::Scope setup_scope(computing_timer, "setup");
-        // The mesh of this cycle, refined from that of the last one by its
-        // indicators: making it is part of the cost of the cycle.
-        if (cycle > 0)
-          refine_grid();
-        setup_system();
-        // The DoFs of the pair (u1h, u2h): both blocks of the solution.
-        const types::global_dof_index n_dofs   = solution.size();
-        const auto                    max_dofs = parameters.refinement.max_dofs;
-        if (max_dofs > 0 && n_dofs > max_dofs)
-          {
-            if (cycle == 0)
-              throw Parameters::invalid_entry("Refinement/Max dofs",
-                                              std::to_string(max_dofs),
-                                              "the first mesh already has " +
-                                                std::to_string(n_dofs) +
-                                                " DoFs");
-            pcout << "Stopping: the next mesh would have " << n_dofs
-                  << " DoFs > Max dofs = " << max_dofs << std::endl;
+        {
+          // Making the mesh of this cycle from the last one is part of its
+          // cost.
+          TimerOutput::Scope scope(computing_timer, "setup");
+          if (cycle > 0)
+            refine_grid();
+          setup_system();
+          if (exceeds_max_dofs(cycle))
             break;
-          }
-        transfer_solution();
-        setup_scope.stop();
-        record.mesh = {cycle,
-                       triangulation->n_global_active_cells(),
-                       triangulation->n_global_levels(),
-                       n_dofs};
-        pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
-              << record.mesh.dofs << " DoFs";
-        if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
-          pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
-                << " processes";
-        pcout << std::endl;
+          transfer_solution();
+        }
+        record_mesh(cycle);
 
         record.solve = solve();
         {
@@ -670,18 +718,7 @@ namespace membranes
         record.errors    = compute_errors();
         record.estimator = estimate_error();
         record.flux      = reconstruct_fluxes();
-        record.times     = phase_times();
-        cumulative_time += record.times.method();
-        record.cumulative_wall_time = cumulative_time;
-        Utilities::System::MemoryStats memory;
-        Utilities::System::get_memory_stats(memory);
-        record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
-        record.memory_mb =
-          Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
-        pcout << "   " << record.solve.active_set_iterations
-              << " active set iterations, " << record.solve.active_vertices
-              << " active vertices, " << record.times.method() << " s"
-              << std::endl;
+        record_costs();
 
         report.add(record);
         previous_record = record;

@@ -107,6 +107,12 @@ namespace membranes
     refine_grid();
     TimeRecord
     phase_times() const;
+    bool
+    exceeds_max_dofs(const unsigned int cycle) const;
+    void
+    record_mesh(const unsigned int cycle);
+    void
+    record_costs();
 
     const Parameters::All &parameters;
     MPI_Comm               mpi_communicator;
