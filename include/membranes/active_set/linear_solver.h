@@ -27,7 +27,12 @@ namespace membranes
    *   multigrid, with the constant near-null-space modes reinit() is given:
    *   one per block of the coupled system of (u1, u2), one for s or w.
    * - `auto`: direct up to direct_solver_dof_limit unknowns on one process,
-   *   cg-amg otherwise.
+   *   cg-amg otherwise, on both cell types. Geometric multigrid is not
+   *   offered: deal.II 9.4 coarsens no simplex mesh and smooths on no
+   *   level of one, so it could serve Q1 only, and on quadrilaterals its
+   *   matrix-free form, built without SIMD in Debian's deal.II, makes a
+   *   CG solve 6 to 8 times slower than ML's AMG at 10⁶ DoFs for about
+   *   the same memory (benchmarks/README.md, "`gmg_floor.sh`").
    *
    * CG stops at the residual norm it is given (the active set method
    * relates it to the size of the forces, not to the right-hand side, whose
