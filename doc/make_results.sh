@@ -15,8 +15,9 @@
 # SECTIONS in the environment chooses what to make (default: all of
 # "benchmarks readme tutorial"); "benchmarks" runs every script of
 # benchmarks/ (about half an hour on two cores, up to 9 GB of memory for
-# mpi_scaling.sh) and the section tutorial summarizes some of their runs, so
-# it comes first. The section tutorial writes doc/tutorial.md,
+# mpi_scaling.sh); the section tutorial summarizes some of their runs and
+# the run of the default scene of section readme (whose figure it shows
+# too), so it comes last. The section tutorial writes doc/tutorial.md,
 # doc/advanced.md (the identities of the flux reconstruction) and the
 # comparison of exact and balanced stopping in benchmarks/README.md. BLOCKS
 # in the environment limits the section benchmarks to the blocks of
@@ -219,13 +220,12 @@ for section in $sections; do
     membranes_run case-m-q1 parameters/case-m-quadrilateral.prm
     membranes_run case-m-p1 parameters/case-m-triangle.prm
     membranes_run full-contact parameters/full-contact.prm
-    for name in case-m-q1 case-m-p1 full-contact; do
-      run $python doc/results.py errors "$work/$name/report.csv" \
-        >"$work/blocks/$name.table"
-    done
-    block doc/tutorial.md case-m-q1 <"$work/blocks/case-m-q1.table"
+    run $python doc/results.py errors case-m "$work/case-m-q1/report.csv=Q1" \
+      "$work/case-m-p1/report.csv=P1" >"$work/blocks/case-m.table"
+    run $python doc/results.py errors full-contact \
+      "$work/full-contact/report.csv" >"$work/blocks/full-contact.table"
+    block doc/tutorial.md case-m <"$work/blocks/case-m.table"
     commands=()
-    block doc/tutorial.md case-m-p1 <"$work/blocks/case-m-p1.table"
     block doc/tutorial.md full-contact <"$work/blocks/full-contact.table"
 
     commands=()
@@ -233,10 +233,6 @@ for section in $sections; do
       --title "Case M" "$work/case-m-q1/report.csv=Q1" \
       "$work/case-m-p1/report.csv=P1"
     figure "$work/case-m-convergence.png" case-m-convergence.png
-    run $python source/plot_report.py --output "$work/full-contact-convergence" \
-      --title "Full contact" --columns err_lambda_L2,err_lambda_L2_omega_h \
-      "$work/full-contact/report.csv"
-    figure "$work/full-contact-convergence.png" full-contact-convergence.png
     doc_commands+=("${commands[@]}")
 
     reports=("$work/case-m-q1/report.csv=case M, Q1"
@@ -284,6 +280,14 @@ for section in $sections; do
     run $python doc/results.py adaptivity "$work/adaptivity" \
       >"$work/blocks/adaptivity.table"
     block doc/tutorial.md adaptivity <"$work/blocks/adaptivity.table"
+
+    # From the run of the default scene and its figure (section readme).
+    commands=("$(quoted "$membranes" --set "Output/Directory=$work/default" \
+      parameters/default.prm)"
+      "$python source/plot_report.py $work/default/report.csv --output $work/default/convergence")
+    run $python doc/results.py adaptive "$work/default/report.csv" \
+      >"$work/blocks/default-run.table"
+    block doc/tutorial.md default-run <"$work/blocks/default-run.table"
 
     commands=()
     run $python doc/make_figures.py "$membranes" "$work/figures" \

@@ -5,7 +5,8 @@ also be used on its own.
 
 Usage::
 
-    results.py errors report.csv
+    results.py errors KIND report.csv[=LABEL] ...
+    results.py adaptive report.csv
     results.py solver report.csv=LABEL ...
     results.py identities report.csv=LABEL ...
     results.py flux-identities report.csv=LABEL ...
@@ -18,17 +19,27 @@ Usage::
     results.py splice DOCUMENT NAME BLOCK-FILE
     results.py check DOCUMENT NAME report.csv
 
-The first ten print Markdown to standard output:
+The first eleven print Markdown to standard output:
 
-* ``errors``: per cycle the cells, DoFs and the error columns with their
-  rates in h (h ~ N^(-1/2), uniform refinement), as the program's terminal
-  table;
+* ``errors``: per run (labelled in the first column if there are several)
+  and each of its last three cycles the DoFs and the errors of KIND, each with its rate in h
+  (h ~ N^(-1/2), uniform refinement) in brackets: ``case-m`` the energy
+  error, the L2 errors of u1 and u2 and the L2(omega) error of the action;
+  ``full-contact`` the energy error, the action error on omega and on
+  omega_h, and (4 s 13/3)^(1/2), s = 2 / sqrt(cells), the norm of lambda on
+  the strip omega minus omega_h to first order (without a rate);
+* ``adaptive``: every sixth cycle and the last one of an adaptive run with
+  an exact solution: DoFs, energy error, estimator, effectivity and the
+  action error;
 * ``solver``: per run and cycle the DoFs, active set iterations, active
   vertices, CG iterations and cumulative wall time;
-* ``identities``: per run the discrete identities of the last cycle;
+* ``identities``: per run the discrete identities of the last cycle (report
+  columns kkt_residual, prop12_defect, complementarity_defect, min_w,
+  min_lambda);
 * ``flux-identities``: per run and cycle the defects of (4.17), (4.18) and of
   the balance of Lemma 17;
-* ``terminal``: the progress lines of one cycle of a run's terminal output;
+* ``terminal``: the progress lines of one cycle of a run's terminal output,
+  up to the cycle's summary line (which holds its run time);
 * ``balanced``: exact against balanced stopping, per scene (pairs of runs):
   sums over the cycles and the finest cycle;
 * ``summary``: one sentence on a run: its last cycle, the rate of the energy
@@ -37,8 +48,9 @@ The first ten print Markdown to standard output:
   of estimator ~ N^(-r) (least squares over the last half of the cycles),
   for scenes without an exact solution;
 * ``adaptivity``: one row per scene and cell type of the output directory of
-  benchmarks/adaptivity.sh: rates, N/N_u and T/T_u at equal error, the
-  effectivity band and the most active set iterations after the first cycle;
+  benchmarks/adaptivity.sh: the rates of uniform and adaptive refinement,
+  the adaptive DoFs at the error of the finest uniform mesh divided by its
+  DoFs, and the effectivity band;
 * ``comparisons``: from the table.md of benchmarks/adaptivity.sh, only the
   comparisons at equal error and the PASS/FAIL lines.
 
@@ -47,9 +59,11 @@ and ``<!-- end of results: NAME -->`` by the contents of BLOCK-FILE; it stops
 with an error (and leaves DOCUMENT as it is) if the markers are missing.
 
 ``check`` compares the error table of block NAME of DOCUMENT with the table
-``errors`` makes from report.csv: the same rows and columns, errors equal to
-1e-3 relative (both are printed with four significant digits) and rates to
-0.011 (two decimals). It prints the first difference and exits with status
+``errors`` makes from report.csv (of the kind whose header the block has):
+the same rows and columns, errors equal to 1e-3 relative (both are printed
+with four significant digits) and rates to 0.011 (two decimals). Without a
+block NAME, NAME is BLOCK-LABEL: the rows of the run LABEL (case ignored) in
+block BLOCK, e.g. case-m-q1 for the rows Q1 of block case-m. It prints the first difference and exits with status
 1 if they differ: a test of the suite runs it, so that a change of the
 program's results cannot leave the tables of the documents behind.
 """
@@ -63,9 +77,35 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(
 import adaptivity_table  # noqa: E402
 from solver_cost_table import number as value, read_report  # noqa: E402
 
-ERROR_COLUMNS = ["err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2",
-                 "err_lambda_L2", "err_lambda_L2_omega_h"]
 
+
+def strip(row):
+    """(4 s 13/3)^(1/2), s = 2 / sqrt(cells): the norm of lambda = 2 + xy of
+    full contact on the strip omega minus omega_h of width s/2 along the
+    boundary of (-1, 1)^2, to first order in s (13/3 is the mean of lambda^2
+    on the boundary)."""
+    return math.sqrt(4 * 2 / math.sqrt(value(row, "cells")) * 13 / 3)
+
+
+def column(name):
+    return lambda row: value(row, name)
+
+
+# The error tables of the tutorial show the last cycles of each run; per
+# kind, (header, value of a row, whether a rate follows the value).
+SHOWN_CYCLES = 3
+ERROR_TABLES = {
+    "case-m": [
+        ("energy error", column("err_energy"), True),
+        ("$L^2$ error of $u_1$", column("err_u1_L2"), True),
+        ("$L^2$ error of $u_2$", column("err_u2_L2"), True),
+        ("action error on $\\omega$", column("err_lambda_L2"), True)],
+    "full-contact": [
+        ("energy error", column("err_energy"), True),
+        ("action error on $\\omega$", column("err_lambda_L2"), True),
+        ("action error on $\\omega_h$", column("err_lambda_L2_omega_h"), True),
+        ("$(4s\\cdot\\tfrac{13}{3})^{1/2}$", strip, False)],
+}
 
 def labelled(arguments):
     """(path, label) of arguments report.csv=LABEL."""
@@ -89,30 +129,53 @@ def short(x):
         else f"{x:.1e}"
 
 
-def errors(path):
-    rows = read_report(path)
-    header = ["cycle", "cells", "dofs"]
-    for column in ERROR_COLUMNS:
-        header += [column, "rate"]
+def errors(kind, arguments):
+    """The table ``errors`` of the runs @p arguments (report.csv[=LABEL])."""
+    runs = list(labelled(arguments))
+    header = (["mesh"] if len(runs) > 1 else []) + ["DoFs"] + \
+        [title for title, _, _ in ERROR_TABLES[kind]]
     table = []
-    for before, row in zip([None] + rows, rows):
-        line = [row["cycle"], row["cells"], row["dofs"]]
-        for column in ERROR_COLUMNS:
-            error = value(row, column)
-            line.append(f"{error:.3e}")
-            if before is None:
-                line.append("-")
-            else:
-                h_ratio = math.sqrt(value(row, "dofs") / value(before, "dofs"))
-                line.append(f"{math.log(value(before, column) / error) / math.log(h_ratio):.2f}")
-        table.append(line)
-    return markdown(header, table, "r" * len(header))
+    for path, label in runs:
+        rows = read_report(path)
+        for index, (before, row) in enumerate(zip([None] + rows, rows)):
+            if index < len(rows) - SHOWN_CYCLES:
+                continue
+            first = index == max(len(rows) - SHOWN_CYCLES, 0)
+            line = [label if first else ""] if len(runs) > 1 else []
+            line.append(row["dofs"])
+            for _, quantity, with_rate in ERROR_TABLES[kind]:
+                error = quantity(row)
+                if before is None or not with_rate:
+                    line.append(f"{error:.3e}")
+                else:
+                    h_ratio = math.sqrt(value(row, "dofs") /
+                                        value(before, "dofs"))
+                    rate = math.log(quantity(before) / error) / \
+                        math.log(h_ratio)
+                    line.append(f"{error:.3e} ({rate:.2f})")
+            table.append(line)
+    return markdown(header, table, "l" * (len(runs) > 1) +
+                    "r" * (len(header) - (len(runs) > 1)))
+
+
+def adaptive(path):
+    """Every sixth cycle and the last of an adaptive run."""
+    rows = read_report(path)
+    shown = [row for index, row in enumerate(rows)
+             if index % 6 == 0 or index == len(rows) - 1]
+    header = ["cycle", "DoFs", "energy error", "estimator $\\eta$",
+              "effectivity $\\eta$ / error", "action error on $\\omega$"]
+    table = [[row["cycle"], row["dofs"], f"{value(row, 'err_energy'):.3e}",
+              f"{value(row, 'estimator'):.3e}",
+              f"{value(row, 'effectivity'):.2f}",
+              f"{value(row, 'err_lambda_L2'):.3e}"] for row in shown]
+    return markdown(header, table, "rrrrrr")
 
 
 def solver(arguments):
     """One row per run: the active set iterations and active vertices of
     each cycle, and the CG iterations of the last one."""
-    header = ["run", "dofs, first to last cycle",
+    header = ["run", "DoFs, first to last cycle",
               "active set iterations per cycle", "active vertices, last cycle",
               "CG iterations, last cycle"]
     table = []
@@ -128,11 +191,15 @@ def solver(arguments):
 def identities(arguments):
     columns = ["kkt_residual", "prop12_defect", "complementarity_defect",
                "min_w", "min_lambda"]
+    header = ["run", "relative KKT residual",
+              "Proposition 12: $\\max_a\\vert\\lambda_{1a}-\\lambda_{2a}\\vert d_a/F$",
+              "(4.8): $\\max_a\\vert\\lambda_ad_aw_a\\vert/(FU_{\\max})$",
+              "$\\min_aw_a$", "$\\min_a\\lambda_a$"]
     table = []
     for path, label in labelled(arguments):
         last = read_report(path)[-1]
         table.append([label] + [short(value(last, c)) for c in columns])
-    return markdown(["run"] + columns, table, "l" + "r" * len(columns))
+    return markdown(header, table, "l" + "r" * len(columns))
 
 
 def flux_identities(arguments):
@@ -147,13 +214,15 @@ def flux_identities(arguments):
 
 
 def terminal(path, cycle):
-    """The lines of cycle @p cycle in a run's terminal output, in a code
-    block."""
+    """The lines of cycle @p cycle in a run's terminal output up to its
+    summary line, in a code block."""
     lines, inside = [], False
     with open(path) as stream:
         for line in stream:
             if line.startswith("Cycle "):
                 inside = line.startswith(f"Cycle {cycle}:")
+            elif not line.startswith("      "):
+                inside = False
             if inside and line.strip():
                 lines.append(line.rstrip())
     if not lines:
@@ -213,27 +282,24 @@ def estimators(arguments):
 
 
 def adaptivity(directory):
-    header = ["scene", "uniform rate", "adaptive rate", "$N/N_u$",
-              "effectivity band (adaptive)",
-              "active set its after the first"]
+    header = ["scene", "rate, uniform", "rate, adaptive",
+              "DoFs adaptive / uniform at equal error",
+              "effectivity, largest / smallest"]
     table = []
     for scene, name in [("lshape", "L-shape"), ("slit", "slit")]:
         for cells in ["q1", "p1"]:
             prefix = os.path.join(directory, f"{scene}-{cells}-")
             uniform = read_report(prefix + "uniform/report.csv")
-            adaptive = read_report(prefix + "adaptive/report.csv")
+            adaptive_rows = read_report(prefix + "adaptive/report.csv")
             target = value(uniform[-1], "err_energy")
-            n, _, _ = adaptivity_table.at_error(adaptive, target)
-            iterations = max(adaptivity_table.max_active_set_iterations(r)
-                             for r in (uniform, adaptive))
+            n, _, _ = adaptivity_table.at_error(adaptive_rows, target)
             table.append([
                 f"{name} {cells.upper()}",
                 f"{adaptivity_table.rate(uniform)[0]:.3f}",
-                f"{adaptivity_table.rate(adaptive)[0]:.3f}",
+                f"{adaptivity_table.rate(adaptive_rows)[0]:.3f}",
                 f"{n / value(uniform[-1], 'dofs'):.3f}",
-                f"{adaptivity_table.effectivity_band(adaptive):.2f}",
-                f"≤ {iterations}"])
-    return markdown(header, table, "lrrrrr")
+                f"{adaptivity_table.effectivity_band(adaptive_rows):.2f}"])
+    return markdown(header, table, "lrrrr")
 
 
 def comparisons(path):
@@ -294,40 +360,78 @@ def table_cells(text):
     return [[cell.strip() for cell in row] for row in rows]
 
 
-def agree(documented, computed, header):
+def numbers_of(cell):
+    """The numbers of a cell "error" or "error (rate)"."""
+    return cell.replace("(", " ").replace(")", " ").split()
+
+
+def agree(documented, computed):
     if documented == computed:
         return True
+    a, b = numbers_of(documented), numbers_of(computed)
+    if len(a) != len(b):
+        return False
     try:
-        a, b = float(documented), float(computed)
+        a, b = [float(x) for x in a], [float(x) for x in b]
     except ValueError:
         return False
-    if header == "rate":
-        return abs(a - b) <= 0.011
-    return abs(a - b) <= 1e-3 * max(abs(a), abs(b))
+    # The error to 1e-3 relative, the rate (the second number) to 0.011.
+    return abs(a[0] - b[0]) <= 1e-3 * max(abs(a[0]), abs(b[0])) and \
+        all(abs(x - y) <= 0.011 for x, y in zip(a[1:], b[1:]))
+
+
+def run_rows(rows, label):
+    """The rows of the run @p label of a table whose first column labels
+    runs (on their first row only), without that column."""
+    kept, current = [], None
+    for row in rows:
+        current = row[0] or current
+        if current.lower() == label.lower():
+            kept.append(row[1:])
+    return kept
 
 
 def check(document, name, report):
-    documented = table_cells(block_text(document, name))
-    computed = table_cells(errors(report))
+    label = None
+    try:
+        text = block_text(document, name)
+    except ValueError:
+        if "-" not in name:
+            raise
+        name, label = name.rsplit("-", 1)
+        text = block_text(document, name)
+    documented = table_cells(text)
+    if not documented:
+        raise ValueError(f"{document}, {name}: no table")
+    header = documented[0][1:] if label else documented[0]
+    kinds = [kind for kind in ERROR_TABLES
+             if table_cells(errors(kind, [report]))[0] == header]
+    if not kinds:
+        raise ValueError(f"{document}, {name}: a header that no kind of "
+                         f"table errors has: {documented[0]}")
+    computed = table_cells(errors(kinds[0], [report]))[1:]
+    documented = run_rows(documented[1:], label) if label \
+        else documented[1:]
     if len(documented) != len(computed):
-        raise ValueError(f"{document}, {name}: {len(documented) - 1} rows, "
-                         f"{report}: {len(computed) - 1}")
-    header = computed[0]
+        raise ValueError(f"{document}, {name}: {len(documented)} rows"
+                         f"{' of ' + label if label else ''}, "
+                         f"{report}: {len(computed)}")
     for documented_row, computed_row in zip(documented, computed):
         for column, (a, b) in enumerate(zip(documented_row, computed_row)):
-            if len(documented_row) != len(computed_row) or \
-                    not agree(a, b, header[column]):
+            if len(documented_row) != len(computed_row) or not agree(a, b):
                 raise ValueError(
-                    f"{document}, {name}: cycle {computed_row[0]}, "
-                    f"{header[column]}: {a} in the document, {b} in {report}"
-                    " (doc/make_results.sh makes the tables anew)")
-    print(f"{document}, {name}: {len(computed) - 1} rows agree with {report}")
+                    f"{document}, {name}: DoFs {computed_row[0]}, "
+                    f"{header[column]}: {a} in the document, {b} in "
+                    f"{report} (doc/make_results.sh makes the tables anew)")
+    print(f"{document}, {name}{' ' + label if label else ''}: "
+          f"{len(computed)} rows agree with {report}")
     return None
 
 
 def main(argv):
     commands = {
-        "errors": lambda a: errors(*a),
+        "errors": lambda a: errors(a[0], a[1:]),
+        "adaptive": lambda a: adaptive(*a),
         "solver": solver,
         "identities": identities,
         "flux-identities": flux_identities,
