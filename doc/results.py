@@ -192,8 +192,8 @@ def identities(arguments):
     columns = ["kkt_residual", "prop12_defect", "complementarity_defect",
                "min_w", "min_lambda"]
     header = ["run", "relative KKT residual",
-              "Proposition 12: $\\max_a\\vert\\lambda_{1a}-\\lambda_{2a}\\vert d_a/F$",
-              "(4.8): $\\max_a\\vert\\lambda_ad_aw_a\\vert/(FU_{\\max})$",
+              "Proposition 12: $\\max_a\\vert\\lambda_{1a}-\\lambda_{2a}\\vert d_a/F_\\infty$",
+              "(4.8): $\\max_a\\vert\\lambda_ad_aw_a\\vert/(F_\\infty U_{\\max})$",
               "$\\min_aw_a$", "$\\min_a\\lambda_a$"]
     table = []
     for path, label in labelled(arguments):
