@@ -198,6 +198,9 @@ for section in $sections; do
     $python doc/results.py summary "$work/default/report.csv" \
       >"$work/blocks/default.table"
     block README.md default <"$work/blocks/default.table"
+    # The progress output of the cycle that the tutorial follows.
+    $python doc/results.py terminal "$work/default.log" 8 |
+      block doc/tutorial.md terminal
 
     commands=()
     run "$membranes" --set "Output/Directory=$work/own-scene" \
@@ -241,9 +244,6 @@ for section in $sections; do
     commands=()
     run $python doc/results.py solver "${reports[@]}" >"$work/blocks/solver.table"
     block doc/tutorial.md solver <"$work/blocks/solver.table"
-    commands=()
-    $python doc/results.py terminal "$work/case-m-q1.log" 4 |
-      block doc/tutorial.md terminal
     commands=()
     run $python doc/results.py identities "${reports[@]}" \
       >"$work/blocks/identities.table"
