@@ -1,16 +1,20 @@
 /**
- * What a matrix-free geometric multigrid costs on the operators of
- * membranes, measured with deal.II's building blocks alone.
+ * What a geometric multigrid costs on the operators of membranes, matrix-
+ * free or on assembled level matrices, measured with deal.II's building
+ * blocks alone.
  *
- *   gmg_floor s gmg|amg [refinements] [local refinements]
- *   gmg_floor w disk|halfplane|ring [refinements]
+ *   gmg_floor s gmg|amg|gmgmatrix [refinements] [local refinements] [degree]
+ *   gmg_floor w disk|halfplane|ring [refinements] [degree]
  *
  * membranes solves its linear systems by CG preconditioned with Trilinos'
  * ML AMG on assembled matrices. This program measures what the other
- * path, CG with a geometric multigrid V-cycle on matrix-free operators in
- * the way of deal.II's step-37 and step-50, costs on the same meshes, and
- * how it copes with the active set of the contact problem. It does not
- * integrate anything into membranes.
+ * path, CG with a geometric multigrid V-cycle, costs on the same meshes,
+ * on matrix-free operators in the way of deal.II's step-37 and step-50 or
+ * on assembled level matrices in the way of step-16 and the matrix-based
+ * path of step-50, and how it copes with the active set of the contact
+ * problem. It does not integrate anything into membranes. The V-cycle on
+ * level matrices is in benchmarks/gmg_floor_matrix.cc, the parts that
+ * both files use in benchmarks/gmg_floor.h.
  *
  * The mesh is the square (-1,1)² in a parallel::distributed::Triangulation
  * (p4est) with the multigrid hierarchy, one coarse cell refined
@@ -36,8 +40,17 @@
  * assembled with FEValues through the same AffineConstraints, and
  * TrilinosWrappers::PreconditionAMG with the settings of membranes'
  * LinearSolver (elliptic, constant modes, 2 smoother sweeps, deal.II's
- * defaults otherwise). Both solve with CG from zero to a residual of
- * 10⁻¹⁰ times that of the right-hand side.
+ * defaults otherwise). With `gmgmatrix`: the same assembled matrix, and a
+ * V-cycle on level matrices: on each level a TrilinosWrappers::SparseMatrix
+ * (double) of the Laplacian assembled on the cells of the level, its rows
+ * at the level boundary DoFs and at the refinement edges left with their
+ * diagonal, and interface matrices on the refinement edges (step-16);
+ * MGTransferPrebuilt between the levels; Chebyshev smoothing of degree
+ * @p degree (default 4) with the inverse of the diagonal of the level
+ * matrix, smoothing range 15 and 10 CG iterations for the eigenvalue
+ * estimate as for `gmg`, so that a V-cycle needs only sparse products,
+ * vector updates and the sparse transfer. All three solve with CG from
+ * zero to a residual of 10⁻¹⁰ times that of the right-hand side.
  *
  * <h3>The `w` problem</h3>
  *
@@ -48,7 +61,7 @@
  * w fixed at the active vertices. The operator is the LaplaceOperator on
  * a MatrixFree whose AffineConstraints hold the boundary and the active
  * vertices (its constrained rows are the identity). Three preconditioners,
- * each applied as Π P Π + (I − Π):
+ * each applied as Π P Π + (I − Π), and two on the assembled matrix:
  *
  *  (a) P the plain V-cycle of the Laplacian of the `s` problem, the active
  *      set unknown to the levels;
@@ -58,7 +71,16 @@
  *      MGConstrainedDoFs::add_user_constraints() as a homogeneous
  *      constraint, so that MGTransferMatrixFree sets it to zero before
  *      each prolongation from that level;
- *  (c) the same on the finest level only, the coarser levels plain.
+ *  (c) the same on the finest level only, the coarser levels plain;
+ *  (d) (b) on assembled level matrices: the operator is the assembled
+ *      matrix of `amg` (its rows at 𝒜 and the boundary keep their
+ *      diagonal), P the V-cycle of `gmgmatrix` whose level DoFs at
+ *      vertices of 𝒜 (the same as (b)'s) are added to the level boundary
+ *      DoFs of MGConstrainedDoFs: the level matrices keep only their
+ *      diagonal in those rows and columns, and MGTransferPrebuilt does not
+ *      prolongate from them;
+ *  (e) for comparison, the path of membranes: ML as in `amg` on the
+ *      assembled matrix of (d), not projected.
  *
  * <h3>What is printed</h3>
  *
@@ -70,12 +92,14 @@
  * memory freed by a step is kept by the allocator: what a step adds is the
  * increase of the peak. Then the time of one preconditioner application
  * (the mean of 5, "V-cycle"; for AMG one ML cycle) and of one product with
- * the operator ("matvec"), also per DoF, the CG iterations and time, and
- * the l2 norm of the solution vector, which does not depend on the
- * numbering of the DoFs and so may be compared between runs on 1 and 2
- * processes. Each process runs on one thread; the rows starting with
+ * the operator ("matvec", matrix-free or sparse), also per DoF, the CG
+ * iterations and time, and the l2 norm of the solution vector, which does not
+ * depend on the numbering of the DoFs and so may be compared between runs on 1
+ * and 2 processes. Each process runs on one thread; the rows starting with
  * "| " are what benchmarks/gmg_floor.sh takes the medians of.
  */
+
+#include "gmg_floor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -128,10 +152,6 @@
 
 namespace gmg_floor
 {
-  using namespace dealii;
-
-  constexpr int dim = 2;
-
   using VectorType      = LinearAlgebra::distributed::Vector<double>;
   using LevelVectorType = LinearAlgebra::distributed::Vector<float>;
   using SystemMatrixType =
@@ -142,122 +162,29 @@ namespace gmg_floor
   using SmootherType = PreconditionChebyshev<LevelMatrixType, LevelVectorType>;
   using PreconditionType = PreconditionMG<dim, LevelVectorType, TransferType>;
 
-  /** The active sets of the `w` problem; `none` for the `s` problem. */
-  enum class Shape
+
+
+  IndexSet
+  active_level_dofs(const DoFHandler<dim>   &dof_handler,
+                    const unsigned int       level,
+                    const Shape              shape,
+                    const MGConstrainedDoFs &constrained_dofs)
   {
-    none,
-    disk,
-    halfplane,
-    ring
-  };
-
-  /** Whether the vertex at @p p belongs to the active set @p shape. */
-  bool
-  in_active_set(const Shape shape, const Point<dim> &p)
-  {
-    const double tolerance = 1e-12;
-    const double r         = p.norm();
-    switch (shape)
-      {
-        case Shape::disk:
-          return r <= 0.5 + tolerance;
-        case Shape::halfplane:
-          return p[0] < 0.3;
-        case Shape::ring:
-          return r >= 0.45 - tolerance && r <= 0.5 + tolerance;
-        default:
-          return false;
-      }
-  }
-
-
-
-  /**
-   * The timed steps: wall time between two barriers, and the peak resident
-   * set size of all processes together after the step.
-   */
-  class Recorder
-  {
-  public:
-    explicit Recorder(const MPI_Comm comm)
-      : comm(comm)
-    {}
-
-    void
-    timed(const std::string &name, const std::function<void()> &action)
-    {
-      MPI_Barrier(comm);
-      const auto start = std::chrono::steady_clock::now();
-      action();
-      MPI_Barrier(comm);
-      const std::chrono::duration<double> seconds =
-        std::chrono::steady_clock::now() - start;
-      steps.push_back({name, seconds.count(), peak_bytes(), held_bytes()});
-    }
-
-    /** A row without a time: the memory of the process when it starts. */
-    void
-    start()
-    {
-      steps.push_back(
-        {"process start (the libraries)", -1, peak_bytes(), held_bytes()});
-    }
-
-    /** The sum over the processes of VmHWM, in bytes. */
-    double
-    peak_bytes() const
-    {
-      Utilities::System::MemoryStats memory;
-      Utilities::System::get_memory_stats(memory);
-      return Utilities::MPI::sum(1024. * memory.VmHWM, comm);
-    }
-
-    /** The sum over the processes of VmRSS, in bytes. */
-    double
-    held_bytes() const
-    {
-      Utilities::System::MemoryStats memory;
-      Utilities::System::get_memory_stats(memory);
-      return Utilities::MPI::sum(1024. * memory.VmRSS, comm);
-    }
-
-    /** The sum of the times of the steps so far. */
-    double
-    total() const
-    {
-      double sum = 0;
-      for (const auto &step : steps)
-        sum += std::max(step.seconds, 0.);
-      return sum;
-    }
-
-    void
-    print(std::ostream &out, const double n_dofs) const
-    {
-      out << "| step | s | peak B/DoF | held B/DoF |\n|---|--:|--:|--:|\n";
-      for (const auto &step : steps)
+    IndexSet                             active(dof_handler.n_dofs(level));
+    std::vector<types::global_dof_index> indices(
+      dof_handler.get_fe().n_dofs_per_cell());
+    for (const auto &cell : dof_handler.mg_cell_iterators_on_level(level))
+      if (cell->level_subdomain_id() != numbers::artificial_subdomain_id)
         {
-          out << "| " << step.name << " | ";
-          if (step.seconds >= 0)
-            out << std::fixed << std::setprecision(3) << step.seconds;
-          out << " | " << std::fixed << std::setprecision(0)
-              << step.peak / n_dofs << " | " << step.held / n_dofs << " |\n";
+          cell->get_mg_dof_indices(indices);
+          for (const unsigned int v : cell->vertex_indices())
+            if (in_active_set(shape, cell->vertex(v)) &&
+                !constrained_dofs.is_boundary_index(level, indices[v]))
+              active.add_index(indices[v]);
         }
-      out << "| **the steps above** | " << std::setprecision(3) << total()
-          << " | | |\n";
-    }
-
-  private:
-    struct Step
-    {
-      std::string name;
-      double      seconds;
-      double      peak;
-      double      held;
-    };
-    const MPI_Comm    comm;
-    std::vector<Step> steps;
-  };
+    active.compress();
+    return active;
+  }
 
 
 
@@ -329,22 +256,9 @@ namespace gmg_floor
               // The level DoFs at the vertices of the active set, as
               // homogeneous constraints of the level operator and as user
               // constraints of the transfer.
-              AffineConstraints<double>            active(relevant_dofs);
-              std::vector<types::global_dof_index> indices(
-                dof_handler.get_fe().n_dofs_per_cell());
-              for (const auto &cell :
-                   dof_handler.mg_cell_iterators_on_level(level))
-                if (cell->level_subdomain_id() !=
-                    numbers::artificial_subdomain_id)
-                  {
-                    cell->get_mg_dof_indices(indices);
-                    for (const unsigned int v : cell->vertex_indices())
-                      if (in_active_set(shape, cell->vertex(v)) &&
-                          !constrained_dofs.is_boundary_index(level,
-                                                              indices[v]) &&
-                          !active.is_constrained(indices[v]))
-                        active.add_line(indices[v]);
-                  }
+              AffineConstraints<double> active(relevant_dofs);
+              active.add_lines(
+                active_level_dofs(dof_handler, level, shape, constrained_dofs));
               active.close();
               level_constraints.merge(
                 active,
@@ -413,10 +327,12 @@ namespace gmg_floor
 
   /**
    * A preconditioner P applied as Π P Π + (I − Π), Π the projection on the
-   * DoFs that the operator does not hold fixed (the constrained DoFs of
-   * its MatrixFree: the boundary and, in the `w` problem, the active set).
+   * DoFs that the operator does not hold fixed (the boundary and, in the
+   * `w` problem, the active set), given by their positions @p fixed in
+   * the local storage of the vectors (the constrained DoFs of a MatrixFree,
+   * or the constrained locally owned DoFs of a Trilinos vector).
    */
-  template <typename Preconditioner>
+  template <typename Preconditioner, typename Vector = VectorType>
   class Projected
   {
   public:
@@ -427,21 +343,21 @@ namespace gmg_floor
     {}
 
     void
-    vmult(VectorType &dst, const VectorType &src) const
+    vmult(Vector &dst, const Vector &src) const
     {
       projected.reinit(src, true);
       projected = src;
       for (const unsigned int i : fixed)
-        projected.local_element(i) = 0;
+        projected.begin()[i] = 0;
       preconditioner.vmult(dst, projected);
       for (const unsigned int i : fixed)
-        dst.local_element(i) = src.local_element(i);
+        dst.begin()[i] = src.begin()[i];
     }
 
   private:
     const Preconditioner            &preconditioner;
     const std::vector<unsigned int> &fixed;
-    mutable VectorType               projected;
+    mutable Vector                   projected;
   };
 
 
@@ -507,16 +423,35 @@ namespace gmg_floor
     void
     run_s_amg();
     void
-    run_w();
+    run_s_gmgmatrix(const unsigned int degree);
+    void
+    run_w(const unsigned int degree);
 
   private:
     void
     setup_matrix_free();
     void
     assemble_rhs();
-    template <typename Preconditioner>
-    unsigned int
-    solve(const Preconditioner &preconditioner);
+    /** The assembled matrix and vectors of the problem (Trilinos). */
+    struct SparseSystem
+    {
+      SparseMatrixType matrix;
+      SparseVectorType rhs, solution;
+    };
+    void
+    assemble_sparse(SparseSystem &system, const std::string &prefix);
+    void
+    initialize_amg(const SparseSystem                &system,
+                   TrilinosWrappers::PreconditionAMG &amg,
+                   const std::string                 &prefix);
+    template <typename Matrix, typename Vector, typename Preconditioner>
+    Result
+    solve(const std::string    &label,
+          const double          setup_start,
+          const Matrix         &matrix,
+          Vector               &solution,
+          const Vector         &rhs,
+          const Preconditioner &preconditioner);
     void
     print(const std::vector<Result> &results);
 
@@ -645,18 +580,36 @@ namespace gmg_floor
 
 
 
-  /** CG from zero to a residual of 10⁻¹⁰ times that of the right-hand side. */
-  template <typename Preconditioner>
-  unsigned int
-  Benchmark::solve(const Preconditioner &preconditioner)
+  /**
+   * CG from zero to a residual of 10⁻¹⁰ times that of the right-hand side,
+   * timed as the step "<prefix of label> CG solve", and the result row:
+   * setup the time of the steps since @p setup_start, the V-cycle and the
+   * operator product timed after the solve.
+   */
+  template <typename Matrix, typename Vector, typename Preconditioner>
+  Result
+  Benchmark::solve(const std::string    &label,
+                   const double          setup_start,
+                   const Matrix         &matrix,
+                   Vector               &solution,
+                   const Vector         &rhs,
+                   const Preconditioner &preconditioner)
   {
-    SolverControl        control(2000, 1e-10 * rhs.l2_norm());
-    SolverCG<VectorType> cg(control);
-    solution = 0;
-    cg.solve(system_matrix, solution, rhs, preconditioner);
-    constraints.distribute(solution);
-    norms.push_back(solution.l2_norm());
-    return control.last_step();
+    Result            result{label, recorder.total() - setup_start, 0, 0, 0, 0};
+    const std::string prefix = label[0] == '(' ? label.substr(0, 4) : "";
+    recorder.timed(prefix + "CG solve", [&]() {
+      SolverControl    control(2000, 1e-10 * rhs.l2_norm());
+      SolverCG<Vector> cg(control);
+      solution = 0;
+      cg.solve(matrix, solution, rhs, preconditioner);
+      constraints.distribute(solution);
+      norms.push_back(solution.l2_norm());
+      result.iterations = control.last_step();
+    });
+    result.solve  = recorder.total() - setup_start - result.setup;
+    result.cycle  = cycle_time(preconditioner, rhs, comm);
+    result.matvec = cycle_time(matrix, rhs, comm);
+    return result;
   }
 
 
@@ -690,15 +643,52 @@ namespace gmg_floor
                            numbers::invalid_unsigned_int,
                            recorder,
                            "");
-    const double       setup = recorder.total() - start;
+    print({solve("GMG V-cycle",
+                 start,
+                 system_matrix,
+                 solution,
+                 rhs,
+                 gmg.preconditioner())});
+  }
 
-    Result result{"GMG V-cycle", setup, 0, 0, 0, 0};
-    recorder.timed("CG solve",
-                   [&]() { result.iterations = solve(gmg.preconditioner()); });
-    result.solve  = recorder.total() - start - setup;
-    result.cycle  = cycle_time(gmg.preconditioner(), rhs, comm);
-    result.matvec = cycle_time(system_matrix, rhs, comm);
-    print({result});
+
+
+  /**
+   * The matrix of the problem assembled with FEValues through the
+   * AffineConstraints into a TrilinosWrappers::SparseMatrix, and the
+   * right-hand side; the constrained rows keep only their diagonal.
+   */
+  void
+  Benchmark::assemble_sparse(SparseSystem &system, const std::string &prefix)
+  {
+    const IndexSet &owned = dof_handler.locally_owned_dofs();
+    recorder.timed(prefix + "sparsity pattern, matrix reinit", [&]() {
+      DynamicSparsityPattern dsp(locally_relevant_dofs);
+      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+      SparsityTools::distribute_sparsity_pattern(dsp,
+                                                 owned,
+                                                 comm,
+                                                 locally_relevant_dofs);
+      system.matrix.reinit(owned, owned, dsp, comm);
+      system.rhs.reinit(owned, comm);
+      system.solution.reinit(owned, comm);
+    });
+    recorder.timed(prefix + "assembly", [&]() {
+      CellLaplacian local(mapping, fe);
+      for (const auto &cell : dof_handler.active_cell_iterators())
+        if (cell->is_locally_owned())
+          {
+            local.reinit(cell);
+            cell->get_dof_indices(local.indices);
+            constraints.distribute_local_to_global(local.matrix,
+                                                   local.rhs,
+                                                   local.indices,
+                                                   system.matrix,
+                                                   system.rhs);
+          }
+      system.matrix.compress(VectorOperation::add);
+      system.rhs.compress(VectorOperation::add);
+    });
   }
 
 
@@ -706,56 +696,24 @@ namespace gmg_floor
   void
   Benchmark::run_s_amg()
   {
-    const IndexSet                   &owned = dof_handler.locally_owned_dofs();
-    TrilinosWrappers::SparseMatrix    matrix;
-    TrilinosWrappers::MPI::Vector     amg_rhs(owned, comm);
-    TrilinosWrappers::MPI::Vector     amg_solution(owned, comm);
+    SparseSystem system;
+    assemble_sparse(system, "");
     TrilinosWrappers::PreconditionAMG amg;
+    const double                      start = recorder.total();
+    initialize_amg(system, amg, "");
+    print({solve(
+      "ML AMG", start, system.matrix, system.solution, system.rhs, amg)});
+  }
 
-    recorder.timed("sparsity pattern, matrix reinit", [&]() {
-      DynamicSparsityPattern dsp(locally_relevant_dofs);
-      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
-      SparsityTools::distribute_sparsity_pattern(dsp,
-                                                 owned,
-                                                 comm,
-                                                 locally_relevant_dofs);
-      matrix.reinit(owned, owned, dsp, comm);
-    });
-    recorder.timed("assembly", [&]() {
-      const QGauss<dim>                    quadrature(2);
-      FEValues<dim>                        fe_values(mapping,
-                              fe,
-                              quadrature,
-                              update_values | update_gradients |
-                                update_JxW_values);
-      const unsigned int                   n = fe.n_dofs_per_cell();
-      FullMatrix<double>                   cell_matrix(n, n);
-      Vector<double>                       cell_rhs(n);
-      std::vector<types::global_dof_index> indices(n);
-      for (const auto &cell : dof_handler.active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            fe_values.reinit(cell);
-            cell_matrix = 0;
-            cell_rhs    = 0;
-            for (const unsigned int q : fe_values.quadrature_point_indices())
-              for (unsigned int i = 0; i < n; ++i)
-                {
-                  for (unsigned int j = 0; j < n; ++j)
-                    cell_matrix(i, j) += fe_values.shape_grad(i, q) *
-                                         fe_values.shape_grad(j, q) *
-                                         fe_values.JxW(q);
-                  cell_rhs(i) += fe_values.shape_value(i, q) * fe_values.JxW(q);
-                }
-            cell->get_dof_indices(indices);
-            constraints.distribute_local_to_global(
-              cell_matrix, cell_rhs, indices, matrix, amg_rhs);
-          }
-      matrix.compress(VectorOperation::add);
-      amg_rhs.compress(VectorOperation::add);
-    });
-    const double start = recorder.total();
-    recorder.timed("AMG setup", [&]() {
+
+
+  /** ML on @p system with the settings of membranes' LinearSolver. */
+  void
+  Benchmark::initialize_amg(const SparseSystem                &system,
+                            TrilinosWrappers::PreconditionAMG &amg,
+                            const std::string                 &prefix)
+  {
+    recorder.timed(prefix + "AMG setup", [&]() {
       std::vector<std::vector<bool>> constant_modes;
       DoFTools::extract_constant_modes(dof_handler,
                                        ComponentMask(),
@@ -765,29 +723,32 @@ namespace gmg_floor
       amg_data.higher_order_elements = false;
       amg_data.constant_modes        = constant_modes;
       amg_data.smoother_sweeps       = 2;
-      amg.initialize(matrix, amg_data);
+      amg.initialize(system.matrix, amg_data);
     });
-    const double setup = recorder.total() - start;
-
-    Result result{"ML AMG", setup, 0, 0, 0, 0};
-    recorder.timed("CG solve", [&]() {
-      SolverControl control(2000, 1e-10 * amg_rhs.l2_norm());
-      SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
-      cg.solve(matrix, amg_solution, amg_rhs, amg);
-      constraints.distribute(amg_solution);
-      norms.push_back(amg_solution.l2_norm());
-      result.iterations = control.last_step();
-    });
-    result.solve  = recorder.total() - start - setup;
-    result.cycle  = cycle_time(amg, amg_rhs, comm);
-    result.matvec = cycle_time(matrix, amg_rhs, comm);
-    print({result});
   }
 
 
 
   void
-  Benchmark::run_w()
+  Benchmark::run_s_gmgmatrix(const unsigned int degree)
+  {
+    SparseSystem system;
+    assemble_sparse(system, "");
+    const double         start = recorder.total();
+    MatrixBasedMultigrid gmg(
+      dof_handler, mapping, Shape::none, degree, recorder, "");
+    print({solve("GMG V-cycle, level matrices",
+                 start,
+                 system.matrix,
+                 system.solution,
+                 system.rhs,
+                 gmg.preconditioner())});
+  }
+
+
+
+  void
+  Benchmark::run_w(const unsigned int degree)
   {
     setup_matrix_free();
     const auto &fixed = system_matrix.get_matrix_free()->get_constrained_dofs();
@@ -803,23 +764,51 @@ namespace gmg_floor
     std::vector<Result> results;
     for (const auto &[label, first_level] : variants)
       {
-        const double start = recorder.total();
-        Result       result{label, 0, 0, 0, 0, 0};
-        {
-          const std::string  prefix = label.substr(0, 3) + " ";
-          GeometricMultigrid gmg(
-            dof_handler, mapping, shape, first_level, recorder, prefix);
-          result.setup = recorder.total() - start;
-          const Projected<PreconditionType> preconditioner(gmg.preconditioner(),
-                                                           fixed);
-          recorder.timed(prefix + "CG solve",
-                         [&]() { result.iterations = solve(preconditioner); });
-          result.solve  = recorder.total() - start - result.setup;
-          result.cycle  = cycle_time(preconditioner, rhs, comm);
-          result.matvec = cycle_time(system_matrix, rhs, comm);
-        }
-        results.push_back(result);
+        const double                      start = recorder.total();
+        GeometricMultigrid                gmg(dof_handler,
+                               mapping,
+                               shape,
+                               first_level,
+                               recorder,
+                               label.substr(0, 4));
+        const Projected<PreconditionType> preconditioner(gmg.preconditioner(),
+                                                         fixed);
+        results.push_back(
+          solve(label, start, system_matrix, solution, rhs, preconditioner));
       }
+
+    // (d): (b) on assembled level matrices, for the assembled operator.
+    {
+      SparseSystem system;
+      assemble_sparse(system, "(d) ");
+      const IndexSet           &owned = dof_handler.locally_owned_dofs();
+      std::vector<unsigned int> fixed_owned;
+      for (unsigned int i = 0; i < owned.n_elements(); ++i)
+        if (constraints.is_constrained(owned.nth_index_in_set(i)))
+          fixed_owned.push_back(i);
+      const double         start = recorder.total();
+      MatrixBasedMultigrid gmg(
+        dof_handler, mapping, shape, degree, recorder, "(d) ");
+      const Projected<SparsePreconditionType, SparseVectorType> preconditioner(
+        gmg.preconditioner(), fixed_owned);
+      results.push_back(solve("(d) (b) on level matrices",
+                              start,
+                              system.matrix,
+                              system.solution,
+                              system.rhs,
+                              preconditioner));
+
+      // (e): membranes' path, ML on the same assembled matrix.
+      TrilinosWrappers::PreconditionAMG amg;
+      const double                      amg_start = recorder.total();
+      initialize_amg(system, amg, "(e) ");
+      results.push_back(solve("(e) ML AMG",
+                              amg_start,
+                              system.matrix,
+                              system.solution,
+                              system.rhs,
+                              amg));
+    }
     print(results);
   }
 } // namespace gmg_floor
@@ -838,16 +827,26 @@ main(int argc, char **argv)
       const std::string                variant =
         (argc > 2) ? argv[2] : (problem == "w" ? "disk" : "gmg");
       const unsigned int refinements = (argc > 3) ? std::stoul(argv[3]) : 10;
-      const unsigned int local       = (argc > 4) ? std::stoul(argv[4]) : 0;
+      const unsigned int local =
+        (argc > 4 && problem == "s") ? std::stoul(argv[4]) : 0;
+      // The degree of the Chebyshev smoother on level matrices: the last
+      // argument after the refinements.
+      const int          degree_argument = problem == "s" ? 5 : 4;
+      const unsigned int degree          = (argc > degree_argument) ?
+                                             std::stoul(argv[degree_argument]) :
+                                             default_matrix_degree;
 
-      if (problem == "s" && (variant == "gmg" || variant == "amg"))
+      if (problem == "s" &&
+          (variant == "gmg" || variant == "amg" || variant == "gmgmatrix"))
         {
           Benchmark benchmark(refinements,
                               local,
                               Shape::none,
-                              variant == "gmg");
+                              variant != "amg");
           if (variant == "gmg")
             benchmark.run_s_gmg();
+          else if (variant == "gmgmatrix")
+            benchmark.run_s_gmgmatrix(degree);
           else
             benchmark.run_s_amg();
         }
@@ -858,12 +857,13 @@ main(int argc, char **argv)
                               variant == "halfplane" ? Shape::halfplane :
                                                        Shape::ring;
           Benchmark   benchmark(refinements, 0, shape, true);
-          benchmark.run_w();
+          benchmark.run_w(degree);
         }
       else
         throw std::invalid_argument(
-          "usage: gmg_floor s gmg|amg [refinements] [local refinements]\n"
-          "       gmg_floor w disk|halfplane|ring [refinements]");
+          "usage: gmg_floor s gmg|amg|gmgmatrix [refinements] "
+          "[local refinements] [degree]\n"
+          "       gmg_floor w disk|halfplane|ring [refinements] [degree]");
     }
   catch (const std::exception &exception)
     {

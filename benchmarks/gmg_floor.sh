@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Matrix-free geometric multigrid against the AMG of membranes:
-# benchmarks/gmg_floor.cc, run several times one after the other, and the
-# medians of its tables.
+# Geometric multigrid (matrix-free or on level matrices) against the AMG of
+# membranes: benchmarks/gmg_floor.cc, run several times one after the
+# other, and the medians of its tables.
 #
 #   benchmarks/gmg_floor.sh [path/to/gmg_floor] [output-dir] [arguments...]
 #
