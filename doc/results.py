@@ -26,7 +26,7 @@ The first eleven print Markdown to standard output:
   (h ~ N^(-1/2), uniform refinement) in brackets: ``case-m`` the energy
   error, the L2 errors of u1 and u2 and the L2(omega) error of the action;
   ``full-contact`` the energy error, the action error on omega and on
-  omega_h, and (4 s 13/3)^(1/2), s = 2 / sqrt(cells), the norm of lambda on
+  omega_h, and (4 l 13/3)^(1/2), l = 2 / sqrt(cells), the norm of lambda on
   the strip omega minus omega_h to first order (without a rate);
 * ``adaptive``: every sixth cycle and the last one of an adaptive run with
   an exact solution: DoFs, energy error, estimator, effectivity and the
@@ -80,9 +80,9 @@ from solver_cost_table import number as value, read_report  # noqa: E402
 
 
 def strip(row):
-    """(4 s 13/3)^(1/2), s = 2 / sqrt(cells): the norm of lambda = 2 + xy of
+    """(4 l 13/3)^(1/2), l = 2 / sqrt(cells): the norm of lambda = 2 + xy of
     full contact on the strip omega minus omega_h of width s/2 along the
-    boundary of (-1, 1)^2, to first order in s (13/3 is the mean of lambda^2
+    boundary of (-1, 1)^2, to first order in l (13/3 is the mean of lambda^2
     on the boundary)."""
     return math.sqrt(4 * 2 / math.sqrt(value(row, "cells")) * 13 / 3)
 
@@ -104,7 +104,7 @@ ERROR_TABLES = {
         ("energy error", column("err_energy"), True),
         ("action error on $\\omega$", column("err_lambda_L2"), True),
         ("action error on $\\omega_h$", column("err_lambda_L2_omega_h"), True),
-        ("$(4s\\cdot\\tfrac{13}{3})^{1/2}$", strip, False)],
+        ("$(4\\ell\\cdot\\tfrac{13}{3})^{1/2}$", strip, False)],
 }
 
 def labelled(arguments):
