@@ -245,7 +245,7 @@ namespace membranes
     lambda_h = action.lambda_h(discrete_problem, hanging_node_constraints);
 
     const KKTDefects defects =
-      active_set.kkt_defects(discrete_problem, action, ghosted_solution);
+      active_set.kkt_defects(discrete_problem, action, solution);
     const double force_scale =
       std::max(action.force_scale(), std::numeric_limits<double>::min());
     const double u_scale = displacement_scale(ghosted_solution);

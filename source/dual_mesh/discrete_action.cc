@@ -29,6 +29,10 @@ namespace membranes
   DiscreteAction<dim>::compute(const DiscreteProblem<dim> &problem,
                                const BlockVectorType      &solution)
   {
+    Assert(!solution.has_ghost_elements(),
+           ExcMessage("DiscreteAction::compute() reads the locally owned "
+                      "DoFs of the solution by position (see "
+                      "DiscreteProblem::local_positions())."));
     // The two terms of (4.5) at every vertex: μ_i ∫ ∇u_ih·∇φ as μ_i times
     // the product of A with the nodal values U_i of membrane i, block i of
     // the solution (those of hanging nodes follow from their parents, whose

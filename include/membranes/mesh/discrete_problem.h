@@ -180,12 +180,17 @@ namespace membranes
     /**
      * W_a = u1h(a) − u2h(a) at the locally owned vertex k of vertices(),
      * read from the local storage of the two blocks of @p solution at the
-     * position of the vertex: no search per entry.
+     * position of the vertex: no search per entry. @p solution holds the
+     * locally owned DoFs alone (a ghosted vector stores its ghost entries
+     * among the owned ones, at other positions).
      */
     double
     nodal_w(const unsigned int                        k,
             const TrilinosWrappers::MPI::BlockVector &solution) const
     {
+      Assert(!solution.has_ghost_elements(),
+             ExcMessage("nodal_w() reads a vector of the locally owned "
+                        "DoFs by position, not a ghosted vector."));
       const unsigned int p = positions[k];
       return solution.block(0).begin()[p] - solution.block(1).begin()[p];
     }
@@ -193,7 +198,9 @@ namespace membranes
     /**
      * The positions of the DoFs of vertices() in the local storage of a
      * vector of the locally owned DoFs (every block of a vector of the mesh
-     * has that layout): reading them there needs no search per entry.
+     * has that layout): reading them there needs no search per entry. A
+     * ghosted vector has another layout; the readers assert that they get
+     * none.
      */
     const std::vector<unsigned int> &
     local_positions() const;
