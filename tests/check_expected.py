@@ -30,9 +30,10 @@ counts                     0          0      cycle, cells, dofs, levels,
 iterations                 0          1      active_set_iterations
 values                     1e-6       0      errors, estimators and their
                                              parts, effectivities
-near zero                  1e-6       atol   err_lambda_L2 and
-                                             err_lambda_L2_omega_h (1e-9:
-                                             no contact), min_w (1e-9),
+near zero                  1e-6       atol   err_lambda_L2,
+                                             err_lambda_L2_omega_h and
+                                             err_lambda_Hm1 (1e-9: no
+                                             contact), min_w (1e-9),
                                              min_lambda (1e-5: the noise of
                                              a residual divided by d_a),
                                              flux_estimator_contact (1e-6),
@@ -86,6 +87,7 @@ TOLERANCES = {
     **{column: (1e-6, 0.0) for column in VALUES},
     "err_lambda_L2": (1e-6, 1e-9),
     "err_lambda_L2_omega_h": (1e-6, 1e-9),
+    "err_lambda_Hm1": (1e-6, 1e-9),
     "min_w": (1e-6, 1e-9),
     "min_lambda": (1e-6, 1e-5),
     "flux_estimator_contact": (1e-6, 1e-6),

@@ -91,7 +91,8 @@ namespace membranes
         {"flux_estimator_contact", flux(&FluxRecord::contact)},
         {"flux_estimator_boundary", flux(&FluxRecord::boundary)},
         {"time_errors_s", times.errors},
-        {"err_lambda_L2_omega_h", error(&ErrorRecord::lambda_L2_omega_h)}};
+        {"err_lambda_L2_omega_h", error(&ErrorRecord::lambda_L2_omega_h)},
+        {"err_lambda_Hm1", error(&ErrorRecord::lambda_Hm1)}};
     }
   } // namespace
 
@@ -170,6 +171,7 @@ namespace membranes
                                          "err_u1_L2",
                                          "err_u2_L2",
                                          "err_lambda_L2",
+                                         "err_lambda_Hm1",
                                          "err_energy",
                                          "estimator",
                                          "effectivity",

@@ -55,10 +55,15 @@ namespace membranes
 
     /**
      * The rule on @p reference_cell (triangle or quadrilateral), exact of
-     * degree @p degree on every reference sub-triangle.
+     * degree @p degree on every reference sub-triangle; with
+     * @p subdivisions = k > 0 a composite rule, the same simplex rule on
+     * each of the 4^k congruent triangles that k bisections of the edges
+     * cut a sub-triangle into, for integrands that are not smooth inside a
+     * sub-triangle (an exact λ that jumps).
      */
     DualCellQuadrature(const ReferenceCell &reference_cell,
-                       const unsigned int   degree);
+                       const unsigned int   degree,
+                       const unsigned int   subdivisions = 0);
 
     /** The points and weights on the reference cell. */
     const Quadrature<dim> &

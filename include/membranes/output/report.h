@@ -64,6 +64,12 @@ namespace membranes
     double lambda_L2_omega_h = 0;
     /** Energy error (Σ_i μ_i |u_i − u_ih|²_{H1})^{1/2} (seminorms). */
     double energy = 0;
+    /**
+     * ‖λ − λ_h‖_{H^{-1}(ω)}, the dual norm (4.20) of H¹₀(ω) with the full
+     * H¹ norm, in which Theorem 21 bounds the error (4.34); λ_h = 0 on the
+     * strip ω ∖ ω_h (NegativeNorm).
+     */
+    double lambda_Hm1 = 0;
   };
 
   /** The flux estimator and the identities of the flux reconstruction. */

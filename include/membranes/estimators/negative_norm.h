@@ -1,0 +1,98 @@
+#ifndef membranes_negative_norm_h
+#define membranes_negative_norm_h
+
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/trilinos_vector.h>
+#include <functional>
+#include <membranes/dual_mesh/dual_cell_quadrature.h>
+#include <membranes/dual_mesh/dual_mesh.h>
+#include <membranes/mesh/discretization.h>
+#include <membranes/scene/problem_data.h>
+#include <vector>
+
+namespace membranes
+{
+  using namespace dealii;
+
+  /**
+   * The norm of H^{-1}(ω), the dual of H¹₀(ω) with the full H¹(ω) norm, as
+   * the paper defines it in (4.20):
+   *
+   *   ‖ρ‖_{H^{-1}(ω)} = sup_{v ∈ H¹₀(ω)} ∫_ω ρ v / ‖v‖_{H¹(ω)},
+   *
+   * the norm in which Theorem 21 bounds the error of the action,
+   * ‖λ − λ_h‖_{H^{-1}(ω)} ≤ c h (4.34). The supremum is attained at the
+   * Riesz representative z ∈ H¹₀(ω) of ρ,
+   *
+   *   ∫ ∇z·∇v + ∫ z v = ∫ ρ v   for all v ∈ H¹₀(ω),
+   *
+   * and equals ‖z‖_{H¹(ω)} = (∫ ρ z)^{1/2}. The class computes z_h, the
+   * Galerkin approximation of z by continuous elements of degree @p degree
+   * (Q_p on quadrilaterals, P_p on triangles) on the mesh of the solution,
+   * and returns ‖z_h‖_{H¹(ω)} = (F·Z)^{1/2}, with F_j = ∫ ρ φ_j and Z the
+   * nodal values of z_h. Galerkin orthogonality in the H¹ inner product
+   * gives ‖z‖² = ‖z_h‖² + ‖z − z_h‖²: the computed norm is a lower bound,
+   * with relative error ‖z − z_h‖²_{H¹} / (2 ‖z‖²_{H¹}).
+   *
+   * The right-hand side is integrated on the pieces K ∩ D_a of the dual
+   * cells (DualCellQuadrature), so that a density that jumps across the
+   * edges of the dual mesh, as λ − λ_h does, is integrated exactly piece by
+   * piece up to the smoothness of λ.
+   */
+  template <int dim>
+  class NegativeNorm
+  {
+  public:
+    using CellIterator = typename Triangulation<dim>::active_cell_iterator;
+
+    /**
+     * ρ on one cell: @p values[q] = ρ(@p points[q]) at the points of
+     * quadrature() mapped to @p cell.
+     */
+    using Density = std::function<void(const CellIterator            &cell,
+                                       const std::vector<Point<dim>> &points,
+                                       std::vector<double>           &values)>;
+
+    /**
+     * The representative z_h of degree @p degree, on the cells and with the
+     * mapping of @p discretization; ∫ ρ φ_j by the three-point rule on each
+     * of the 4^k pieces of every sub-triangle (k = @p density_subdivisions,
+     * DualCellQuadrature).
+     */
+    NegativeNorm(const Discretization<dim> &discretization,
+                 const unsigned int         degree               = 2,
+                 const unsigned int         density_subdivisions = 2);
+
+    /** ‖ρ‖_{H^{-1}(ω)} by ‖z_h‖_{H¹(ω)}, on the mesh @p triangulation. */
+    double
+    norm(const Triangulation<dim> &triangulation,
+         const Density            &rho,
+         const MPI_Comm            mpi_communicator) const;
+
+    /**
+     * ‖λ − λ_h‖_{H^{-1}(ω)} with the exact λ of @p data and λ_h of
+     * @p lambda_h (DiscreteAction::lambda_h(), ghosted) on the dual cells of
+     * @p dual_mesh, and λ_h = 0 on the strip ω ∖ ω_h, as in the L²(ω)
+     * error (ErrorNorms).
+     */
+    double
+    lambda_error(const DoFHandler<dim>               &dof_handler,
+                 const DualMesh<dim>                 &dual_mesh,
+                 const TrilinosWrappers::MPI::Vector &lambda_h,
+                 const ProblemData<dim>              &data,
+                 const MPI_Comm                       mpi_communicator) const;
+
+    /** The rule on the pieces K ∩ D_a that integrates ρ φ_j. */
+    const DualCellQuadrature<dim> &
+    quadrature() const;
+
+  private:
+    const Discretization<dim>                &discretization;
+    const std::unique_ptr<FiniteElement<dim>> fe;
+    const Quadrature<dim>                     cell_quadrature;
+    const DualCellQuadrature<dim>             density_quadrature;
+  };
+} // namespace membranes
+
+#endif

@@ -1,0 +1,222 @@
+#include <array>
+#include <cmath>
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_q.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/sparsity_tools.h>
+#include <deal.II/lac/trilinos_precondition.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <membranes/estimators/negative_norm.h>
+#include <membranes/mesh/cell_loop.h>
+
+namespace membranes
+{
+  namespace
+  {
+    template <int dim>
+    std::unique_ptr<FiniteElement<dim>>
+    riesz_element(const Parameters::CellType cell_type,
+                  const unsigned int         degree)
+    {
+      if (cell_type == Parameters::CellType::triangle)
+        return std::make_unique<FE_SimplexP<dim>>(degree);
+      return std::make_unique<FE_Q<dim>>(degree);
+    }
+
+
+
+    template <int dim>
+    Quadrature<dim>
+    riesz_cell_quadrature(const Parameters::CellType cell_type,
+                          const unsigned int         degree)
+    {
+      if (cell_type == Parameters::CellType::triangle)
+        return QGaussSimplex<dim>(degree + 1);
+      return QGauss<dim>(degree + 1);
+    }
+  } // namespace
+
+
+
+  template <int dim>
+  NegativeNorm<dim>::NegativeNorm(const Discretization<dim> &discretization,
+                                  const unsigned int         degree,
+                                  const unsigned int density_subdivisions)
+    : discretization(discretization)
+    , fe(riesz_element<dim>(discretization.cell_type, degree))
+    , cell_quadrature(
+        riesz_cell_quadrature<dim>(discretization.cell_type, degree))
+    , density_quadrature(fe->reference_cell(), 2, density_subdivisions)
+  {}
+
+
+
+  template <int dim>
+  double
+  NegativeNorm<dim>::norm(const Triangulation<dim> &triangulation,
+                          const Density            &rho,
+                          const MPI_Comm            mpi_communicator) const
+  {
+    // The space of z_h: degree p on the mesh, zero on ∂ω, with the hanging
+    // node constraints of its own DoFs.
+    DoFHandler<dim> dof_handler(triangulation);
+    dof_handler.distribute_dofs(*fe);
+    const IndexSet &owned = dof_handler.locally_owned_dofs();
+    IndexSet        relevant;
+    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    AffineConstraints<double> constraints(relevant);
+    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
+    for (const auto id : triangulation.get_boundary_ids())
+      DoFTools::make_zero_boundary_constraints(dof_handler, id, constraints);
+    constraints.close();
+
+    DynamicSparsityPattern dsp(relevant);
+    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               owned,
+                                               mpi_communicator,
+                                               relevant);
+    TrilinosWrappers::SparseMatrix matrix;
+    matrix.reinit(owned, owned, dsp, mpi_communicator);
+    TrilinosWrappers::MPI::Vector rhs(owned, mpi_communicator);
+
+    // The H¹ inner product ∫ ∇φ_i·∇φ_j + φ_i φ_j with the Gauss rule of the
+    // element, and ∫ ρ φ_i on the pieces of the dual cells.
+    struct Scratch
+    {
+      Scratch(const Mapping<dim>       &mapping,
+              const FiniteElement<dim> &fe,
+              const Quadrature<dim>    &cell_quadrature,
+              const Quadrature<dim>    &density_quadrature)
+        : fe_values(mapping,
+                    fe,
+                    cell_quadrature,
+                    update_values | update_gradients | update_JxW_values)
+        , density_values(mapping,
+                         fe,
+                         density_quadrature,
+                         update_values | update_quadrature_points |
+                           update_JxW_values)
+      {}
+      FEValues<dim>       fe_values, density_values;
+      std::vector<double> rho;
+    };
+    struct Copy
+    {
+      FullMatrix<double>                   cell_matrix;
+      Vector<double>                       cell_rhs;
+      std::vector<types::global_dof_index> dof_indices;
+    };
+    const unsigned int n_dofs = fe->n_dofs_per_cell();
+    run_on_cells<Copy>(
+      dof_handler,
+      [&]() {
+        return std::make_unique<Scratch>(*discretization.mapping,
+                                         *fe,
+                                         cell_quadrature,
+                                         density_quadrature.quadrature());
+      },
+      [&](const auto &cell, Scratch &scratch, Copy &copy) {
+        copy.dof_indices.clear();
+        if (!cell->is_locally_owned())
+          return;
+        copy.cell_matrix.reinit(n_dofs, n_dofs);
+        copy.cell_rhs.reinit(n_dofs);
+        copy.dof_indices.resize(n_dofs);
+        cell->get_dof_indices(copy.dof_indices);
+
+        const FEValues<dim> &fe_values = scratch.fe_values;
+        scratch.fe_values.reinit(cell);
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          for (unsigned int i = 0; i < n_dofs; ++i)
+            for (unsigned int j = 0; j < n_dofs; ++j)
+              copy.cell_matrix(i, j) +=
+                (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) +
+                 fe_values.shape_value(i, q) * fe_values.shape_value(j, q)) *
+                fe_values.JxW(q);
+
+        const FEValues<dim> &density_values = scratch.density_values;
+        scratch.density_values.reinit(cell);
+        rho(cell, density_values.get_quadrature_points(), scratch.rho);
+        for (const unsigned int q : density_values.quadrature_point_indices())
+          {
+            const double rho_JxW = scratch.rho[q] * density_values.JxW(q);
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              copy.cell_rhs(i) += rho_JxW * density_values.shape_value(i, q);
+          }
+      },
+      [&](const Copy &copy) {
+        if (!copy.dof_indices.empty())
+          constraints.distribute_local_to_global(
+            copy.cell_matrix, copy.cell_rhs, copy.dof_indices, matrix, rhs);
+      });
+    matrix.compress(VectorOperation::add);
+    rhs.compress(VectorOperation::add);
+
+    // (A + M) Z = F by CG with an AMG hierarchy for elements of higher
+    // degree; ‖z_h‖²_{H¹} = F·Z (F is zero in the constrained rows).
+    TrilinosWrappers::PreconditionAMG                 amg;
+    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+    amg_data.elliptic              = true;
+    amg_data.higher_order_elements = fe->degree > 1;
+    amg.initialize(matrix, amg_data);
+    TrilinosWrappers::MPI::Vector           z(owned, mpi_communicator);
+    ReductionControl                        control(1000, 1e-300, 1e-12);
+    SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
+    cg.solve(matrix, z, rhs, amg);
+    return std::sqrt(std::max(rhs * z, 0.));
+  }
+
+
+
+  template <int dim>
+  double
+  NegativeNorm<dim>::lambda_error(const DoFHandler<dim> &dof_handler,
+                                  const DualMesh<dim>   &dual_mesh,
+                                  const TrilinosWrappers::MPI::Vector &lambda_h,
+                                  const ProblemData<dim>              &data,
+                                  const MPI_Comm mpi_communicator) const
+  {
+    // λ_h on the piece K ∩ D_a of each point, read on the cell of the mesh
+    // of the solution that is the same cell of the triangulation. The
+    // threads of the cell loop call it at once: it keeps no state.
+    const auto rho = [&](const CellIterator            &cell,
+                         const std::vector<Point<dim>> &points,
+                         std::vector<double>           &values) {
+      typename ProblemData<dim>::ExactValues               exact;
+      const typename DoFHandler<dim>::active_cell_iterator solution_cell(
+        &dof_handler.get_triangulation(),
+        cell->level(),
+        cell->index(),
+        &dof_handler);
+      std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
+      for (const unsigned int v : cell->vertex_indices())
+        vertex_values[v] = dual_mesh.lambda_h_value(solution_cell, v, lambda_h);
+      data.set_gradient_step(1e-4 * cell->diameter());
+      data.exact_solution_list(points, exact);
+      values.resize(points.size());
+      for (unsigned int q = 0; q < points.size(); ++q)
+        values[q] = exact.lambda[q] -
+                    vertex_values[density_quadrature.vertex_of_point(q)];
+    };
+    return norm(dof_handler.get_triangulation(), rho, mpi_communicator);
+  }
+
+
+
+  template <int dim>
+  const DualCellQuadrature<dim> &
+  NegativeNorm<dim>::quadrature() const
+  {
+    return density_quadrature;
+  }
+
+
+
+  template class NegativeNorm<2>;
+} // namespace membranes
