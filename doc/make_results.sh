@@ -223,10 +223,13 @@ for section in $sections; do
     membranes_run case-m-q1 parameters/case-m-quadrilateral.prm
     membranes_run case-m-p1 parameters/case-m-triangle.prm
     membranes_run full-contact parameters/full-contact.prm
+    membranes_run full-contact-p1 parameters/full-contact.prm \
+      --set "Geometry/Cell type=triangle"
     run $python doc/results.py errors case-m "$work/case-m-q1/report.csv=Q1" \
       "$work/case-m-p1/report.csv=P1" >"$work/blocks/case-m.table"
     run $python doc/results.py errors full-contact \
-      "$work/full-contact/report.csv" >"$work/blocks/full-contact.table"
+      "$work/full-contact/report.csv=Q1" \
+      "$work/full-contact-p1/report.csv=P1" >"$work/blocks/full-contact.table"
     block doc/tutorial.md case-m <"$work/blocks/case-m.table"
     commands=()
     block doc/tutorial.md full-contact <"$work/blocks/full-contact.table"

@@ -24,10 +24,11 @@ The first eleven print Markdown to standard output:
 * ``errors``: per run (labelled in the first column if there are several)
   and each of its last three cycles the DoFs and the errors of KIND, each with its rate in h
   (h ~ N^(-1/2), uniform refinement) in brackets: ``case-m`` the energy
-  error, the L2 errors of u1 and u2 and the L2(omega) error of the action;
-  ``full-contact`` the energy error, the action error on omega and on
-  omega_h, and (4 l 13/3)^(1/2), l = 2 / sqrt(cells), the norm of lambda on
-  the strip omega minus omega_h to first order (without a rate);
+  error, the L2 errors of u1 and u2 and the L2(omega) and H^-1(omega)
+  errors of the action; ``full-contact`` the energy error, the action error
+  on omega and on omega_h, (4 l 13/3)^(1/2), l = 2 / sqrt(cells), the norm
+  of lambda on the strip omega minus omega_h to first order (without a
+  rate), and the H^-1(omega) error of the action;
 * ``adaptive``: every sixth cycle and the last one of an adaptive run with
   an exact solution: DoFs, energy error, estimator, effectivity and the
   action error;
@@ -99,12 +100,14 @@ ERROR_TABLES = {
         ("energy error", column("err_energy"), True),
         ("$L^2$ error of $u_1$", column("err_u1_L2"), True),
         ("$L^2$ error of $u_2$", column("err_u2_L2"), True),
-        ("action error on $\\omega$", column("err_lambda_L2"), True)],
+        ("action error on $\\omega$", column("err_lambda_L2"), True),
+        ("action error in $H^{-1}(\\omega)$", column("err_lambda_Hm1"), True)],
     "full-contact": [
         ("energy error", column("err_energy"), True),
         ("action error on $\\omega$", column("err_lambda_L2"), True),
         ("action error on $\\omega_h$", column("err_lambda_L2_omega_h"), True),
-        ("$(4\\ell\\cdot\\tfrac{13}{3})^{1/2}$", strip, False)],
+        ("$(4\\ell\\cdot\\tfrac{13}{3})^{1/2}$", strip, False),
+        ("action error in $H^{-1}(\\omega)$", column("err_lambda_Hm1"), True)],
 }
 
 def labelled(arguments):

@@ -284,7 +284,7 @@ namespace membranes
                                    lambda_h,
                                    mpi_communicator);
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
-    // (benchmarks/README.md, "The H^{-1} norm of the action").
+    // (benchmarks/README.md, "The H^-1 norm of the action").
     const double lambda_Hm1 =
       NegativeNorm<dim>(discretization)
         .lambda_error(dof_handler, dual_mesh, lambda_h, data, mpi_communicator);

@@ -36,9 +36,10 @@ namespace membranes
    * with relative error ‖z − z_h‖²_{H¹} / (2 ‖z‖²_{H¹}).
    *
    * The right-hand side is integrated on the pieces K ∩ D_a of the dual
-   * cells (DualCellQuadrature), so that a density that jumps across the
-   * edges of the dual mesh, as λ − λ_h does, is integrated exactly piece by
-   * piece up to the smoothness of λ.
+   * cells (DualCellQuadrature), on which λ_h is constant: the three-point
+   * rule on each piece, and on the cells where ρ jumps by more than a
+   * threshold (an exact λ that jumps across a curve inside the pieces) the
+   * same rule on each of the 4^k parts of every piece.
    */
   template <int dim>
   class NegativeNorm
@@ -48,33 +49,41 @@ namespace membranes
 
     /**
      * ρ on one cell: @p values[q] = ρ(@p points[q]) at the points of
-     * quadrature() mapped to @p cell.
+     * @p rule mapped to @p cell (its vertex_of_point() gives the piece
+     * K ∩ D_a of each point).
      */
     using Density = std::function<void(const CellIterator            &cell,
+                                       const DualCellQuadrature<dim> &rule,
                                        const std::vector<Point<dim>> &points,
                                        std::vector<double>           &values)>;
 
     /**
      * The representative z_h of degree @p degree, on the cells and with the
-     * mapping of @p discretization; ∫ ρ φ_j by the three-point rule on each
-     * of the 4^k pieces of every sub-triangle (k = @p density_subdivisions,
-     * DualCellQuadrature).
+     * mapping of @p discretization; ∫ ρ φ_j with 4^k parts of every piece
+     * (k = @p jump_subdivisions) where ρ jumps.
      */
     NegativeNorm(const Discretization<dim> &discretization,
-                 const unsigned int         degree               = 2,
-                 const unsigned int         density_subdivisions = 2);
+                 const unsigned int         degree            = 2,
+                 const unsigned int         jump_subdivisions = 4);
 
-    /** ‖ρ‖_{H^{-1}(ω)} by ‖z_h‖_{H¹(ω)}, on the mesh @p triangulation. */
+    /**
+     * ‖ρ‖_{H^{-1}(ω)} by ‖z_h‖_{H¹(ω)}, on the mesh @p triangulation; the
+     * cells on which the values of ρ at the points of the three-point rule
+     * differ by more than @p jump take the composite rule.
+     */
     double
     norm(const Triangulation<dim> &triangulation,
          const Density            &rho,
+         const double              jump,
          const MPI_Comm            mpi_communicator) const;
 
     /**
      * ‖λ − λ_h‖_{H^{-1}(ω)} with the exact λ of @p data and λ_h of
      * @p lambda_h (DiscreteAction::lambda_h(), ghosted) on the dual cells of
      * @p dual_mesh, and λ_h = 0 on the strip ω ∖ ω_h, as in the L²(ω)
-     * error (ErrorNorms).
+     * error (ErrorNorms). The composite rule takes the cells where λ − λ_h
+     * varies by more than a tenth of max |λ_h|: where λ jumps, not where it
+     * is smooth, on which it varies by O(h).
      */
     double
     lambda_error(const DoFHandler<dim>               &dof_handler,
@@ -83,15 +92,12 @@ namespace membranes
                  const ProblemData<dim>              &data,
                  const MPI_Comm                       mpi_communicator) const;
 
-    /** The rule on the pieces K ∩ D_a that integrates ρ φ_j. */
-    const DualCellQuadrature<dim> &
-    quadrature() const;
-
   private:
     const Discretization<dim>                &discretization;
     const std::unique_ptr<FiniteElement<dim>> fe;
     const Quadrature<dim>                     cell_quadrature;
     const DualCellQuadrature<dim>             density_quadrature;
+    const DualCellQuadrature<dim>             jump_quadrature;
   };
 } // namespace membranes
 
