@@ -2,6 +2,7 @@
 #include <array>
 #include <cmath>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
@@ -80,7 +81,15 @@ namespace membranes
     const IndexSet &owned = dof_handler.locally_owned_dofs();
     IndexSet        relevant;
     DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
-    AffineConstraints<double> constraints(relevant);
+    // On a parallel::shared::Triangulation the ghost cells' faces with
+    // hanging nodes can have artificial children, whose DoFs the hanging
+    // node constraints of degree 2 constrain too: there the constraints
+    // take every DoF (the mesh is on every process anyway).
+    const bool distributed =
+      dynamic_cast<const parallel::DistributedTriangulationBase<dim> *>(
+        &triangulation) != nullptr;
+    AffineConstraints<double> constraints(
+      distributed ? relevant : complete_index_set(dof_handler.n_dofs()));
     DoFTools::make_hanging_node_constraints(dof_handler, constraints);
     for (const auto id : triangulation.get_boundary_ids())
       DoFTools::make_zero_boundary_constraints(dof_handler, id, constraints);
