@@ -276,12 +276,12 @@ namespace membranes
     if (!data.exact_solution_known())
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
-    const auto         errors = ErrorNorms<dim>(discretization, data)
-                          .compute(dof_handler,
-                                   ghosted_solution,
-                                   dual_mesh,
-                                   lambda_h,
-                                   mpi_communicator);
+    const auto         errors =
+      ErrorNorms<dim>(discretization,
+                      data,
+                      parameters.exact_solution.reference_quadrature)
+        .compute(
+          dof_handler, ghosted_solution, dual_mesh, lambda_h, mpi_communicator);
     // The full H1 norm of (3.5) from the seminorm and the L2 norm.
     const auto full_norm = [&](const unsigned int i) {
       return std::sqrt(std::pow(errors.u_H1_seminorm[i], 2) +

@@ -8,6 +8,15 @@ namespace membranes
   DualCellQuadrature<dim>::DualCellQuadrature(
     const ReferenceCell &reference_cell,
     const unsigned int   degree)
+    : DualCellQuadrature(reference_cell, QGaussSimplex<dim>((degree + 2) / 2))
+  {}
+
+
+
+  template <int dim>
+  DualCellQuadrature<dim>::DualCellQuadrature(
+    const ReferenceCell   &reference_cell,
+    const Quadrature<dim> &simplex_rule)
   {
     static_assert(dim == 2, "The dual mesh is implemented for dim = 2.");
     const unsigned int n_vertices = reference_cell.n_vertices();
@@ -51,9 +60,8 @@ namespace membranes
           triangles.push_back(triangle);
         }
 
-    const QGaussSimplex<dim> simplex_rule((degree + 2) / 2);
-    std::vector<Point<dim>>  points;
-    std::vector<double>      weights;
+    std::vector<Point<dim>> points;
+    std::vector<double>     weights;
     for (unsigned int s = 0; s < triangles.size(); ++s)
       {
         const auto &corners = triangles[s].corners;

@@ -60,6 +60,13 @@ namespace membranes
     DualCellQuadrature(const ReferenceCell &reference_cell,
                        const unsigned int   degree);
 
+    /**
+     * The rule on @p reference_cell with @p simplex_rule, a rule on the
+     * reference triangle, mapped onto every reference sub-triangle.
+     */
+    DualCellQuadrature(const ReferenceCell   &reference_cell,
+                       const Quadrature<dim> &simplex_rule);
+
     /** The points and weights on the reference cell. */
     const Quadrature<dim> &
     quadrature() const;
