@@ -277,12 +277,12 @@ namespace membranes
     if (!data.exact_solution_known())
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
-    const auto         errors = ErrorNorms<dim>(discretization, data)
-                          .compute(dof_handler,
-                                   ghosted_solution,
-                                   dual_mesh,
-                                   lambda_h,
-                                   mpi_communicator);
+    const auto         errors =
+      ErrorNorms<dim>(discretization,
+                      data,
+                      parameters.exact_solution.reference_quadrature)
+        .compute(
+          dof_handler, ghosted_solution, dual_mesh, lambda_h, mpi_communicator);
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
     // (benchmarks/README.md, "The H^-1 norm of the action").
     const double lambda_Hm1 =

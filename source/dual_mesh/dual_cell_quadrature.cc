@@ -7,8 +7,16 @@ namespace membranes
   template <int dim>
   DualCellQuadrature<dim>::DualCellQuadrature(
     const ReferenceCell &reference_cell,
-    const unsigned int   degree,
-    const unsigned int   subdivisions)
+    const unsigned int   degree)
+    : DualCellQuadrature(reference_cell, QGaussSimplex<dim>((degree + 2) / 2))
+  {}
+
+
+
+  template <int dim>
+  DualCellQuadrature<dim>::DualCellQuadrature(
+    const ReferenceCell   &reference_cell,
+    const Quadrature<dim> &simplex_rule)
   {
     static_assert(dim == 2, "The dual mesh is implemented for dim = 2.");
     const unsigned int n_vertices = reference_cell.n_vertices();
@@ -52,40 +60,19 @@ namespace membranes
           triangles.push_back(triangle);
         }
 
-    // The simplex rule on each sub-triangle, or on each of its 4^k
-    // pieces: the corner triangles and the middle one of the midpoints of
-    // its edges, k times over. A piece has the area of its triangle / 4^k.
-    const QGaussSimplex<dim> simplex_rule((degree + 2) / 2);
-    std::vector<Point<dim>>  points;
-    std::vector<double>      weights;
+    std::vector<Point<dim>> points;
+    std::vector<double>     weights;
     for (unsigned int s = 0; s < triangles.size(); ++s)
       {
-        std::vector<std::array<Point<dim>, 3>> pieces{triangles[s].corners};
-        for (unsigned int level = 0; level < subdivisions; ++level)
+        const auto &corners = triangles[s].corners;
+        for (unsigned int q = 0; q < simplex_rule.size(); ++q)
           {
-            std::vector<std::array<Point<dim>, 3>> finer;
-            for (const auto &c : pieces)
-              {
-                const Point<dim> m01 = (c[0] + c[1]) / 2,
-                                 m12 = (c[1] + c[2]) / 2,
-                                 m20 = (c[2] + c[0]) / 2;
-                finer.push_back({{c[0], m01, m20}});
-                finer.push_back({{m01, c[1], m12}});
-                finer.push_back({{m20, m12, c[2]}});
-                finer.push_back({{m12, m20, m01}});
-              }
-            pieces.swap(finer);
+            const Point<dim> &xi = simplex_rule.point(q);
+            points.push_back(corners[0] + xi[0] * (corners[1] - corners[0]) +
+                             xi[1] * (corners[2] - corners[0]));
+            weights.push_back(simplex_rule.weight(q) * 2 * triangles[s].area);
+            triangle_of_points.push_back(s);
           }
-        const double piece_area = triangles[s].area / pieces.size();
-        for (const auto &corners : pieces)
-          for (unsigned int q = 0; q < simplex_rule.size(); ++q)
-            {
-              const Point<dim> &xi = simplex_rule.point(q);
-              points.push_back(corners[0] + xi[0] * (corners[1] - corners[0]) +
-                               xi[1] * (corners[2] - corners[0]));
-              weights.push_back(simplex_rule.weight(q) * 2 * piece_area);
-              triangle_of_points.push_back(s);
-            }
       }
     rule = Quadrature<dim>(points, weights);
   }

@@ -49,10 +49,12 @@ namespace membranes
 
   template <int dim>
   void
-  DualMesh<dim>::lambda_h_values(const CellIterator  &cell,
-                                 const VectorType    &lambda_h,
-                                 std::vector<double> &values,
-                                 std::vector<bool>   *in_omega_h) const
+  DualMesh<dim>::lambda_h_values(
+    const DualCellQuadrature<dim> &dual_cell_quadrature,
+    const CellIterator            &cell,
+    const VectorType              &lambda_h,
+    std::vector<double>           &values,
+    std::vector<bool>             *in_omega_h) const
   {
     // λ_h is constant on the pieces of each vertex: look it up once per
     // vertex, not once per point.
@@ -63,8 +65,6 @@ namespace membranes
         vertex_values[v]     = lambda_h_value(cell, v, lambda_h);
         vertex_in_omega_h[v] = is_interior_vertex(cell, v);
       }
-    const DualCellQuadrature<dim> &dual_cell_quadrature =
-      discretization.dual_cell_quadrature;
     values.resize(dual_cell_quadrature.quadrature().size());
     if (in_omega_h)
       in_omega_h->resize(values.size());

@@ -13,6 +13,7 @@
 #include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/trilinos_precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <membranes/estimators/error_norms.h>
 #include <membranes/estimators/negative_norm.h>
 #include <membranes/mesh/cell_loop.h>
 
@@ -20,14 +21,6 @@ namespace membranes
 {
   namespace
   {
-    /**
-     * The share of max |λ_h| by which λ − λ_h must vary on a cell for the
-     * composite rule: where the exact λ jumps.
-     */
-    constexpr double jump_fraction = 0.1;
-
-
-
     template <int dim>
     std::unique_ptr<FiniteElement<dim>>
     riesz_element(const Parameters::CellType cell_type,
@@ -62,7 +55,9 @@ namespace membranes
     , cell_quadrature(
         riesz_cell_quadrature<dim>(discretization.cell_type, degree))
     , density_quadrature(fe->reference_cell(), 2)
-    , jump_quadrature(fe->reference_cell(), 2, jump_subdivisions)
+    , jump_quadrature(fe->reference_cell(),
+                      QIteratedSimplex<dim>(QGaussSimplex<dim>(2),
+                                            1u << jump_subdivisions))
   {}
 
 
@@ -253,7 +248,7 @@ namespace membranes
     };
     // λ − λ_h varies by O(h) on a cell where λ is smooth, and by the jump
     // where λ jumps (λ_h between the values on either side).
-    const double jump = jump_fraction * lambda_h.linfty_norm();
+    const double jump = lambda_jump_fraction * lambda_h.linfty_norm();
     return norm(dof_handler.get_triangulation(), rho, jump, mpi_communicator);
   }
 

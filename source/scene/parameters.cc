@@ -284,6 +284,14 @@ namespace membranes::Parameters
                       "lambda, g = u1 and g2 = u2 on the boundary (Problem/"
                       "f1, f2, g, g2 are then not set). Needs compiled "
                       "expressions.");
+    prm.declare_entry("Reference quadrature",
+                      "0",
+                      Integer(0, 6),
+                      "0: the error norms' own rule; N > 0: all errors "
+                      "integrated instead by a composite rule, each "
+                      "sub-triangle of the dual mesh cut into 4^N triangles "
+                      "with 4 points on each, the reference of "
+                      "benchmarks/error_quadrature.sh (slow).");
     prm.leave_subsection();
   }
 
@@ -298,6 +306,8 @@ namespace membranes::Parameters
     u1_gradient  = prm.get("u1 gradient");
     u2_gradient  = prm.get("u2 gradient");
     manufactured = prm.get_bool("Manufactured data");
+
+    reference_quadrature = prm.get_integer("Reference quadrature");
     prm.leave_subsection();
   }
 

@@ -780,5 +780,17 @@ namespace membranes
 
 
 
+  template <int dim>
+  void
+  ProblemData<dim>::exact_action_list(const std::vector<Point<dim>> &points,
+                                      std::vector<double> &values) const
+  {
+    Assert(known, ExcInternalError());
+    values.resize(points.size());
+    exact_action->value_list(points, values);
+  }
+
+
+
   template class ProblemData<2>;
 } // namespace membranes

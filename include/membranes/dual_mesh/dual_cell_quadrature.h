@@ -55,15 +55,17 @@ namespace membranes
 
     /**
      * The rule on @p reference_cell (triangle or quadrilateral), exact of
-     * degree @p degree on every reference sub-triangle; with
-     * @p subdivisions = k > 0 a composite rule, the same simplex rule on
-     * each of the 4^k congruent triangles that k bisections of the edges
-     * cut a sub-triangle into, for integrands that are not smooth inside a
-     * sub-triangle (an exact λ that jumps).
+     * degree @p degree on every reference sub-triangle.
      */
     DualCellQuadrature(const ReferenceCell &reference_cell,
-                       const unsigned int   degree,
-                       const unsigned int   subdivisions = 0);
+                       const unsigned int   degree);
+
+    /**
+     * The rule on @p reference_cell with @p simplex_rule, a rule on the
+     * reference triangle, mapped onto every reference sub-triangle.
+     */
+    DualCellQuadrature(const ReferenceCell   &reference_cell,
+                       const Quadrature<dim> &simplex_rule);
 
     /** The points and weights on the reference cell. */
     const Quadrature<dim> &

@@ -86,7 +86,22 @@ namespace membranes
     lambda_h_values(const CellIterator  &cell,
                     const VectorType    &lambda_h,
                     std::vector<double> &values,
-                    std::vector<bool>   *in_omega_h = nullptr) const;
+                    std::vector<bool>   *in_omega_h = nullptr) const
+    {
+      lambda_h_values(discretization.dual_cell_quadrature,
+                      cell,
+                      lambda_h,
+                      values,
+                      in_omega_h);
+    }
+
+    /** The same at the points of another rule @p quadrature on the pieces. */
+    void
+    lambda_h_values(const DualCellQuadrature<dim> &quadrature,
+                    const CellIterator            &cell,
+                    const VectorType              &lambda_h,
+                    std::vector<double>           &values,
+                    std::vector<bool>             *in_omega_h = nullptr) const;
 
   private:
     const Discretization<dim> &discretization;
@@ -114,10 +129,24 @@ namespace membranes
                    const DualMesh<dim>                 &dual_mesh,
                    const TrilinosWrappers::MPI::Vector &lambda_h,
                    const UpdateFlags                    update_flags)
+      : DualCellValues(discretization,
+                       discretization.dual_cell_quadrature,
+                       dual_mesh,
+                       lambda_h,
+                       update_flags)
+    {}
+
+    /** The same at the points of another rule @p quadrature on the pieces. */
+    DualCellValues(const Discretization<dim>           &discretization,
+                   const DualCellQuadrature<dim>       &quadrature,
+                   const DualMesh<dim>                 &dual_mesh,
+                   const TrilinosWrappers::MPI::Vector &lambda_h,
+                   const UpdateFlags                    update_flags)
       : fe_values(*discretization.mapping,
                   *discretization.fe,
-                  discretization.dual_cell_quadrature.quadrature(),
+                  quadrature.quadrature(),
                   update_flags)
+      , quadrature(quadrature)
       , dual_mesh(dual_mesh)
       , nodal_lambda_h(lambda_h)
     {
@@ -138,7 +167,8 @@ namespace membranes
         cell->get_dof_values(solution.block(i),
                              local_dofs[i].begin(),
                              local_dofs[i].end());
-      dual_mesh.lambda_h_values(cell, nodal_lambda_h, lambda_h, &in_omega_h);
+      dual_mesh.lambda_h_values(
+        quadrature, cell, nodal_lambda_h, lambda_h, &in_omega_h);
     }
 
     FEValues<dim> fe_values;
@@ -146,6 +176,7 @@ namespace membranes
     std::array<std::vector<double>, 2>   local_dofs;
     std::vector<double>                  lambda_h;
     std::vector<bool>                    in_omega_h;
+    const DualCellQuadrature<dim>       &quadrature;
     const DualMesh<dim>                 &dual_mesh;
     const TrilinosWrappers::MPI::Vector &nodal_lambda_h;
   };

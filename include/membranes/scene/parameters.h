@@ -189,6 +189,11 @@ namespace membranes::Parameters
      * g = u1 and g2 = u2 on ∂ω (Problem/f1, f2, g, g2 stay unset).
      */
     bool manufactured;
+    /**
+     * 0, or N > 0: the errors by the composite reference rule of ErrorNorms
+     * with 4^N triangles per sub-triangle.
+     */
+    unsigned int reference_quadrature;
 
     static void
     declare_parameters(ParameterHandler &prm);

@@ -153,6 +153,16 @@ namespace membranes
     exact_solution_list(const std::vector<Point<dim>> &points,
                         ExactValues                   &values) const;
 
+    /**
+     * The exact λ alone at @p points, into @p values (resized to them);
+     * only when known. For points where λ is wanted and u may be singular
+     * (on the edges and at the vertices of the mesh: the slit, a re-entrant
+     * corner). Each value checked as value() checks it.
+     */
+    void
+    exact_action_list(const std::vector<Point<dim>> &points,
+                      std::vector<double>           &values) const;
+
     /** μ1 and μ2 as `mu[0]`, `mu[1]`. */
     const std::array<double, 2> mu;
 
