@@ -26,7 +26,7 @@ The first eleven print Markdown to standard output:
   (h ~ N^(-1/2), uniform refinement) in brackets: ``case-m`` the energy
   error, the L2 errors of u1 and u2 and the L2(omega) and H^-1(omega)
   errors of the action; ``full-contact`` the energy error, the action error
-  on omega and on omega_h, (4 l 13/3)^(1/2), l = 2 / sqrt(cells), the norm
+  on omega and on omega_h, (4 l 13/3)^(1/2), l the side of the grid, the norm
   of lambda on the strip omega minus omega_h to first order (without a
   rate), and the H^-1(omega) error of the action;
 * ``adaptive``: every sixth cycle and the last one of an adaptive run with
@@ -81,11 +81,13 @@ from solver_cost_table import number as value, read_report  # noqa: E402
 
 
 def strip(row):
-    """(4 l 13/3)^(1/2), l = 2 / sqrt(cells): the norm of lambda = 2 + xy of
-    full contact on the strip omega minus omega_h of width s/2 along the
-    boundary of (-1, 1)^2, to first order in l (13/3 is the mean of lambda^2
-    on the boundary)."""
-    return math.sqrt(4 * 2 / math.sqrt(value(row, "cells")) * 13 / 3)
+    """(4 l 13/3)^(1/2), l = 2 / n on the uniform n x n grid of vertices
+    with n + 1 = (dofs / 2)^(1/2) (squares, or squares cut into two
+    triangles): the norm of lambda = 2 + xy of full contact on the strip
+    omega minus omega_h of width l/2 along the boundary of (-1, 1)^2, to
+    first order in l (13/3 is the mean of lambda^2 on the boundary)."""
+    n = math.sqrt(value(row, "dofs") / 2) - 1
+    return math.sqrt(4 * 2 / n * 13 / 3)
 
 
 def column(name):
