@@ -21,8 +21,9 @@ namespace membranes
    * of K (the vertex average on quadrilaterals). It is the union of the two
    * triangles κ = (a, m_e, b_K), the cells of the paper's sub-mesh S_h: one
    * for every edge e of K and every end a of e. This class holds these
-   * reference sub-triangles and a QGaussSimplex rule mapped onto each of
-   * them, with the sub-triangle (and so the vertex a) of every point.
+   * reference sub-triangles and a rule on the reference triangle (a
+   * QGaussSimplex rule, or any other) mapped onto each of them, with the
+   * sub-triangle (and so the vertex a) of every point.
    * FEValues maps the rule to the physical cell: for triangles the pieces
    * map to the physical pieces exactly (affine map); for quadrilaterals the
    * bilinear map sends the edges a–m_e and m_e–b_K to straight segments, so

@@ -52,7 +52,10 @@ namespace membranes
     double complementarity_defect = 0;
   };
 
-  /** The errors against a known exact solution, in the norms of the paper. */
+  /**
+   * The errors against a known exact solution, in the norms of the paper,
+   * as ErrorNorms integrates them (its rules and their accuracy there).
+   */
   struct ErrorRecord
   {
     /** The full H1(ω) norms ‖u_i − u_ih‖_{H1(ω)} of (3.5). */
