@@ -18,8 +18,10 @@ independently of the program,
 For every row of the report the check asks
 
 * err_lambda_L2^2 - err_lambda_L2_omega_h^2 = ||lambda||^2_{L2(strip)}
-  to a relative 1e-5 (the quadrature of the program integrates the
-  polynomial lambda^2 to about 1e-6 on the coarsest mesh);
+  to a relative 1e-4 (the three-point rule of degree 2 of the program on
+  each sub-triangle integrates the polynomial lambda^2, of degree 4, to
+  2e-5 on the coarsest mesh of 16 cells and 3e-7 on the next; a strip of
+  the wrong width is off by O(1));
 * err_lambda_L2 >= ||lambda||_{L2(strip)}.
 
 Catches: an error on omega_h reported as the error on omega, a strip of the
@@ -32,7 +34,7 @@ import sys
 
 from check_report import ReportError, read_csv
 
-RTOL = 1e-5
+RTOL = 1e-4
 
 
 def strip_norm(cells):

@@ -288,7 +288,8 @@ namespace membranes::Parameters
                       "0",
                       Integer(0, 6),
                       "0: the error norms' own rule; N > 0: all errors "
-                      "integrated instead by a composite rule, each "
+                      "but err_lambda_Hm1 integrated instead by a "
+                      "composite rule, each "
                       "sub-triangle of the dual mesh cut into 4^N triangles "
                       "with 4 points on each, the reference of "
                       "benchmarks/error_quadrature.sh (slow).");
