@@ -42,6 +42,36 @@ namespace membranes
         return QGaussSimplex<dim>(degree + 1);
       return QGauss<dim>(degree + 1);
     }
+
+
+
+    /** What one thread of the assembly of NegativeNorm works with. */
+    template <int dim>
+    struct RieszScratch
+    {
+      RieszScratch(const Mapping<dim>       &mapping,
+                   const FiniteElement<dim> &fe,
+                   const Quadrature<dim>    &cell_quadrature,
+                   const Quadrature<dim>    &density_quadrature,
+                   const Quadrature<dim>    &jump_quadrature)
+        : fe_values(mapping,
+                    fe,
+                    cell_quadrature,
+                    update_values | update_gradients | update_JxW_values)
+        , density_values(mapping,
+                         fe,
+                         density_quadrature,
+                         update_values | update_quadrature_points |
+                           update_JxW_values)
+        , jump_values(mapping,
+                      fe,
+                      jump_quadrature,
+                      update_values | update_quadrature_points |
+                        update_JxW_values)
+      {}
+      FEValues<dim>       fe_values, density_values, jump_values;
+      std::vector<double> rho;
+    };
   } // namespace
 
 
@@ -63,71 +93,17 @@ namespace membranes
 
 
   template <int dim>
-  double
-  NegativeNorm<dim>::norm(const Triangulation<dim> &triangulation,
-                          const Density            &rho,
-                          const double              jump,
-                          const MPI_Comm            mpi_communicator) const
+  void
+  NegativeNorm<dim>::assemble(const DoFHandler<dim>           &dof_handler,
+                              const AffineConstraints<double> &constraints,
+                              const Density                   &rho,
+                              const double                     jump,
+                              TrilinosWrappers::SparseMatrix  &matrix,
+                              TrilinosWrappers::MPI::Vector   &rhs) const
   {
-    // The space of z_h: degree p on the mesh, zero on ∂ω, with the hanging
-    // node constraints of its own DoFs.
-    DoFHandler<dim> dof_handler(triangulation);
-    dof_handler.distribute_dofs(*fe);
-    const IndexSet &owned = dof_handler.locally_owned_dofs();
-    IndexSet        relevant;
-    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
-    // On a parallel::shared::Triangulation the ghost cells' faces with
-    // hanging nodes can have artificial children, whose DoFs the hanging
-    // node constraints of degree 2 constrain too: there the constraints
-    // take every DoF (the mesh is on every process anyway).
-    const bool distributed =
-      dynamic_cast<const parallel::DistributedTriangulationBase<dim> *>(
-        &triangulation) != nullptr;
-    AffineConstraints<double> constraints(
-      distributed ? relevant : complete_index_set(dof_handler.n_dofs()));
-    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
-    for (const auto id : triangulation.get_boundary_ids())
-      DoFTools::make_zero_boundary_constraints(dof_handler, id, constraints);
-    constraints.close();
-
-    DynamicSparsityPattern dsp(relevant);
-    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
-    SparsityTools::distribute_sparsity_pattern(dsp,
-                                               owned,
-                                               mpi_communicator,
-                                               relevant);
-    TrilinosWrappers::SparseMatrix matrix;
-    matrix.reinit(owned, owned, dsp, mpi_communicator);
-    TrilinosWrappers::MPI::Vector rhs(owned, mpi_communicator);
-
     // The H¹ inner product ∫ ∇φ_i·∇φ_j + φ_i φ_j with the Gauss rule of the
     // element, and ∫ ρ φ_i on the pieces of the dual cells, by the composite
     // rule where ρ jumps.
-    struct Scratch
-    {
-      Scratch(const Mapping<dim>       &mapping,
-              const FiniteElement<dim> &fe,
-              const Quadrature<dim>    &cell_quadrature,
-              const Quadrature<dim>    &density_quadrature,
-              const Quadrature<dim>    &jump_quadrature)
-        : fe_values(mapping,
-                    fe,
-                    cell_quadrature,
-                    update_values | update_gradients | update_JxW_values)
-        , density_values(mapping,
-                         fe,
-                         density_quadrature,
-                         update_values | update_quadrature_points |
-                           update_JxW_values)
-        , jump_values(mapping,
-                      fe,
-                      jump_quadrature,
-                      update_values | update_quadrature_points |
-                        update_JxW_values)
-      {}
-      FEValues<dim>       fe_values, density_values, jump_values;
-      std::vector<double> rho;
-    };
     struct Copy
     {
       FullMatrix<double>                   cell_matrix;
@@ -138,13 +114,14 @@ namespace membranes
     run_on_cells<Copy>(
       dof_handler,
       [&]() {
-        return std::make_unique<Scratch>(*discretization.mapping,
-                                         *fe,
-                                         cell_quadrature,
-                                         density_quadrature.quadrature(),
-                                         jump_quadrature.quadrature());
+        return std::make_unique<RieszScratch<dim>>(
+          *discretization.mapping,
+          *fe,
+          cell_quadrature,
+          density_quadrature.quadrature(),
+          jump_quadrature.quadrature());
       },
-      [&](const auto &cell, Scratch &scratch, Copy &copy) {
+      [&](const auto &cell, RieszScratch<dim> &scratch, Copy &copy) {
         copy.dof_indices.clear();
         if (!cell->is_locally_owned())
           return;
@@ -195,6 +172,48 @@ namespace membranes
       });
     matrix.compress(VectorOperation::add);
     rhs.compress(VectorOperation::add);
+  }
+
+
+
+  template <int dim>
+  double
+  NegativeNorm<dim>::norm(const Triangulation<dim> &triangulation,
+                          const Density            &rho,
+                          const double              jump,
+                          const MPI_Comm            mpi_communicator) const
+  {
+    // The space of z_h: degree p on the mesh, zero on ∂ω, with the hanging
+    // node constraints of its own DoFs.
+    DoFHandler<dim> dof_handler(triangulation);
+    dof_handler.distribute_dofs(*fe);
+    const IndexSet &owned = dof_handler.locally_owned_dofs();
+    IndexSet        relevant;
+    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+    // On a parallel::shared::Triangulation the ghost cells' faces with
+    // hanging nodes can have artificial children, whose DoFs the hanging
+    // node constraints of degree 2 constrain too: there the constraints
+    // take every DoF (the mesh is on every process anyway).
+    const bool distributed =
+      dynamic_cast<const parallel::DistributedTriangulationBase<dim> *>(
+        &triangulation) != nullptr;
+    AffineConstraints<double> constraints(
+      distributed ? relevant : complete_index_set(dof_handler.n_dofs()));
+    DoFTools::make_hanging_node_constraints(dof_handler, constraints);
+    for (const auto id : triangulation.get_boundary_ids())
+      DoFTools::make_zero_boundary_constraints(dof_handler, id, constraints);
+    constraints.close();
+
+    DynamicSparsityPattern dsp(relevant);
+    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+    SparsityTools::distribute_sparsity_pattern(dsp,
+                                               owned,
+                                               mpi_communicator,
+                                               relevant);
+    TrilinosWrappers::SparseMatrix matrix;
+    matrix.reinit(owned, owned, dsp, mpi_communicator);
+    TrilinosWrappers::MPI::Vector rhs(owned, mpi_communicator);
+    assemble(dof_handler, constraints, rho, jump, matrix, rhs);
 
     // (A + M) Z = F by CG with an AMG hierarchy for elements of higher
     // degree. ‖z_h‖²_{H¹} = max_Y 2 F·Y − Y·(A + M)Y, attained at Y = Z: the

@@ -3,6 +3,8 @@
 
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <functional>
 #include <membranes/dual_mesh/dual_cell_quadrature.h>
@@ -93,6 +95,18 @@ namespace membranes
                  const MPI_Comm                       mpi_communicator) const;
 
   private:
+    /**
+     * The H¹ inner product (A + M) of the representative's space of
+     * @p dof_handler and F_j = ∫ ρ φ_j, condensed with @p constraints.
+     */
+    void
+    assemble(const DoFHandler<dim>           &dof_handler,
+             const AffineConstraints<double> &constraints,
+             const Density                   &rho,
+             const double                     jump,
+             TrilinosWrappers::SparseMatrix  &matrix,
+             TrilinosWrappers::MPI::Vector   &rhs) const;
+
     const Discretization<dim>                &discretization;
     const std::unique_ptr<FiniteElement<dim>> fe;
     const Quadrature<dim>                     cell_quadrature;
