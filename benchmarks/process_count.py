@@ -8,7 +8,7 @@ Defaults: build/membranes of this repository and
 (P1, parameters/case-m-triangle.prm) and on quadrilaterals (Q1,
 parameters/case-m-quadrilateral.prm), and full contact on the square (Q1,
 parameters/full-contact.prm), refined adaptively for 9 cycles by each
-estimator (residual, flux) with each marking (bulk, fixed fraction), on 1,
+estimator (residual, flux) with each marking (bulk, fixed number), on 1,
 2 and 3 processes (mpiexec -n N --oversubscribe), with `Solver/Linear
 solver = cg-amg` and `Solver/Tolerance = 1e-12`, no field output. (With
 `auto`, the one-process runs would solve their first meshes, up to 1000
@@ -47,7 +47,7 @@ OUTPUT = sys.argv[2] if len(sys.argv) > 2 else "/tmp/membranes-process-count"
 TOLERANCE = os.environ.get("TOLERANCE", "1e-12")
 SCENES = ["case-m-triangle", "case-m-quadrilateral", "full-contact"]
 ESTIMATORS = ["residual", "flux"]
-MARKINGS = ["bulk", "fixed fraction"]
+MARKINGS = ["bulk", "fixed number"]
 PROCESSES = [1, 2, 3]
 CYCLES = 9
 COLUMNS = ["err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2",

@@ -471,8 +471,8 @@ namespace membranes
   /**
    * Global refinement, or adaptive refinement by the estimator's η_K²:
    * bulk (Dörfler) marking refines the fewest cells whose η_K² sum up to
-   * the share θ of η², fixed fraction the share θ of the cells with the
-   * largest η_K (coarsening likewise at the other end). With `Minimum
+   * the share θ of η², fixed number a share of the cells with the largest
+   * η_K (coarsening likewise at the other end). With `Minimum
    * growth` g > 1, a marking that refines fewer than the share
    * (g − 1)/(2^dim − 1) of the cells is extended to that share, again by
    * the largest η_K: both sets are the cells above a threshold, so the
@@ -511,7 +511,7 @@ namespace membranes
         mark_cells(*triangulation,
                    indicators,
                    refinement.marking,
-                   refinement.bulk_parameter,
+                   refinement.refined_share(),
                    refinement.coarsen_fraction,
                    mpi_communicator);
         const double least_share =
@@ -525,7 +525,7 @@ namespace membranes
             least_share * triangulation->n_global_active_cells())
           mark_cells(*triangulation,
                      indicators,
-                     Parameters::Marking::fixed_fraction,
+                     Parameters::Marking::fixed_number,
                      least_share,
                      0,
                      mpi_communicator);

@@ -87,6 +87,27 @@ CASES = [
     ("Bulk parameter = 0",
      "subsection Refinement\n  set Bulk parameter = 0\nend\n", [],
      ["Refinement/Bulk parameter"]),
+    # The former name of fixed number, deal.II's name of the bulk criterion:
+    # refused with both of what to write instead.
+    ("Marking = fixed fraction",
+     "subsection Refinement\n  set Marking = fixed fraction\nend\n", [],
+     ["Refinement/Marking", "'fixed number'", "'Refinement fraction'",
+      "'bulk'", "'Bulk parameter'"]),
+    ("Marking = fixed fraction by --set",
+     "", ["--set", "Refinement/Marking=fixed fraction"],
+     ["Refinement/Marking", "'fixed number'", "'bulk'"]),
+    ("Refinement fraction = 0",
+     "subsection Refinement\n  set Marking = fixed number\n"
+     "  set Refinement fraction = 0\nend\n", [],
+     ["Refinement/Refinement fraction"]),
+    # The share of the other marking: the scene meant that marking.
+    ("Bulk parameter with Marking = fixed number",
+     "subsection Refinement\n  set Marking = fixed number\n"
+     "  set Bulk parameter = 0.3\nend\n", [],
+     ["Refinement/Bulk parameter", "Refinement fraction"]),
+    ("Refinement fraction with Marking = bulk",
+     "subsection Refinement\n  set Refinement fraction = 0.3\nend\n", [],
+     ["Refinement/Refinement fraction", "Bulk parameter"]),
     ("Minimum growth below 1",
      "subsection Refinement\n  set Minimum growth = 0.5\nend\n", [],
      ["Refinement/Minimum growth"]),
@@ -164,7 +185,8 @@ def check_good_command_lines(membranes):
              "Linear solver", "Tolerance", "Max active set iterations",
              "Stopping", "Balance fraction",
              "Strategy", "Cycles", "Marking",
-             "Bulk parameter", "Coarsen fraction", "Minimum growth",
+             "Bulk parameter", "Refinement fraction", "Coarsen fraction",
+             "Minimum growth",
              "Max dofs", "Estimator", "Target estimator", "Directory",
              "Report",
              "Write vtu", "Write nodal values", "Flux reconstruction"]

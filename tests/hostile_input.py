@@ -250,7 +250,8 @@ TYPED_ENTRIES = [
     "Solver/Max active set iterations", "Solver/Stopping",
     "Solver/Balance fraction", "Refinement/Strategy",
     "Refinement/Cycles", "Refinement/Marking", "Refinement/Bulk parameter",
-    "Refinement/Coarsen fraction", "Refinement/Max dofs",
+    "Refinement/Refinement fraction", "Refinement/Coarsen fraction",
+    "Refinement/Max dofs",
     "Refinement/Estimator", "Output/Report", "Output/Write vtu",
     "Output/Flux reconstruction"]
 
@@ -263,6 +264,7 @@ NUMERIC_ENTRIES = {
     "Solver/Tolerance": set(),
     "Solver/Balance fraction": set(),
     "Refinement/Bulk parameter": set(),
+    "Refinement/Refinement fraction": set(),
     "Geometry/Initial refinement": {"-0"},
     "Refinement/Cycles": set(),
 }
@@ -270,11 +272,13 @@ NUMERIC_ENTRIES = {
 
 def scene_with(entry, value):
     """A scene that sets one entry (and Known = true for an exact
-    solution, so that it is used)."""
+    solution, Marking = fixed number for its share, so that it is used)."""
     subsection, name = entry.split("/")
     entries = {name.replace(" ", "_"): value}
     if subsection == "Exact solution" and name != "Known":
         entries["Known"] = "true"
+    if name == "Refinement fraction":
+        entries["Marking"] = "fixed number"
     return section(subsection, **entries)
 
 
@@ -329,9 +333,16 @@ def values():
 # (name, scene, words the message must contain)
 SCENE_ERRORS = [
     ("Bulk parameter + Coarsen fraction = 1.5",
-     section("Refinement", Strategy="adaptive", Marking="fixed fraction",
-             Bulk_parameter="1", Coarsen_fraction="0.5"),
-     ["Refinement/Coarsen fraction"]),
+     section("Refinement", Strategy="adaptive", Bulk_parameter="1",
+             Coarsen_fraction="0.5"),
+     ["Refinement/Coarsen fraction", "Bulk parameter"]),
+    ("Refinement fraction + Coarsen fraction = 1.5",
+     section("Refinement", Strategy="adaptive", Marking="fixed number",
+             Refinement_fraction="1", Coarsen_fraction="0.5"),
+     ["Refinement/Coarsen fraction", "Refinement fraction"]),
+    ("Marking = fixed fraction (the former name of fixed number)",
+     section("Refinement", Strategy="adaptive", Marking="fixed fraction"),
+     ["Refinement/Marking", "'fixed number'", "'bulk'"]),
     ("Max dofs = -1", section("Refinement", Max_dofs="-1"),
      ["Refinement/Max dofs"]),
     ("Max dofs = 2.5", section("Refinement", Max_dofs="2.5"),

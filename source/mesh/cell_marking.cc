@@ -27,7 +27,7 @@ namespace membranes
       const std::size_t size = last - first;
       if (fraction <= 0)
         return 0;
-      if (marking == Parameters::Marking::fixed_fraction)
+      if (marking == Parameters::Marking::fixed_number)
         return static_cast<std::size_t>(fraction * size);
       const double total = std::accumulate(first, last, 0.);
       if (total == 0)

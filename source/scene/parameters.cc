@@ -2,6 +2,7 @@
 #include <deal.II/base/utilities.h>
 #include <membranes/scene/parameters.h>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 namespace membranes::Parameters
@@ -84,8 +85,7 @@ namespace membranes::Parameters
       {"global", RefinementStrategy::global},
       {"adaptive", RefinementStrategy::adaptive}};
     const Choices<Marking>   markings{{"bulk", Marking::bulk},
-                                    {"fixed fraction",
-                                       Marking::fixed_fraction}};
+                                    {"fixed number", Marking::fixed_number}};
     const Choices<Estimator> estimators{{"residual", Estimator::residual},
                                         {"flux", Estimator::flux}};
     const Choices<ExpressionEvaluation> evaluations{
@@ -93,15 +93,29 @@ namespace membranes::Parameters
       {"compiled", ExpressionEvaluation::compiled},
       {"parser", ExpressionEvaluation::parser}};
 
-    /** The Selection pattern of @p choices: their words, in this order. */
+    /**
+     * The former name of `Marking = fixed number`, which deal.II gives the
+     * bulk criterion: in the pattern of the entry, so that reading it can
+     * say what to write instead.
+     */
+    const std::string former_fixed_number = "fixed fraction";
+
+    /** The defaults of `Bulk parameter` and `Refinement fraction`. */
+    const std::string default_bulk_parameter      = "0.5";
+    const std::string default_refinement_fraction = "0.5";
+
+    /**
+     * The Selection pattern of @p choices: their words, in this order, and
+     * the word @p refused, which reading the entry rejects.
+     */
     template <typename Enum>
     Selection
-    selection(const Choices<Enum> &choices)
+    selection(const Choices<Enum> &choices, const std::string &refused = "")
     {
       std::string words;
       for (const auto &choice : choices)
         words += (words.empty() ? "" : "|") + choice.first;
-      return Selection(words);
+      return Selection(refused.empty() ? words : words + "|" + refused);
     }
 
     /**
@@ -395,23 +409,40 @@ namespace membranes::Parameters
                       "Number of meshes (cycles) of the run.");
     prm.declare_entry("Marking",
                       "bulk",
-                      selection(markings),
-                      "Marking for adaptive refinement: bulk (Doerfler) "
-                      "refines the fewest cells that hold the share 'Bulk "
-                      "parameter' of the squared estimator; fixed fraction "
-                      "refines that share of the cells, those with the "
-                      "largest indicators.");
+                      selection(markings, former_fixed_number),
+                      "Marking for adaptive refinement, by deal.II's "
+                      "names: bulk (Doerfler marking, the bulk criterion; "
+                      "deal.II's refine_and_coarsen_fixed_fraction) "
+                      "refines the fewest cells, those with the largest "
+                      "indicators, whose squared indicators sum up to the "
+                      "share 'Bulk parameter' of the squared estimator; "
+                      "fixed number (deal.II's "
+                      "refine_and_coarsen_fixed_number) refines the share "
+                      "'Refinement fraction' of the cells, those with the "
+                      "largest indicators. 'fixed fraction' is refused with "
+                      "what to write instead: this entry once used it for "
+                      "fixed number.");
     prm.declare_entry("Bulk parameter",
-                      "0.5",
+                      default_bulk_parameter,
                       Double(0, 1),
-                      "The share theta of the marking (0 < theta <= 1).");
+                      "The share theta of the squared estimator that "
+                      "Marking = bulk refines (0 < theta <= 1); only with "
+                      "bulk.");
+    prm.declare_entry("Refinement fraction",
+                      default_refinement_fraction,
+                      Double(0, 1),
+                      "The share of the cells that Marking = fixed number "
+                      "refines, those with the largest indicators (0 < "
+                      "share <= 1); only with fixed number.");
     prm.declare_entry("Coarsen fraction",
                       "0",
                       Double(0, 1),
-                      "The same share for coarsening, at the small end of "
-                      "the indicators, with Bulk parameter + Coarsen "
-                      "fraction <= 1; 0 = no coarsening (quadrilaterals "
-                      "only: deal.II 9.4 cannot coarsen triangles).");
+                      "The share coarsened at the small end of the "
+                      "indicators, of the squared estimator (bulk) or of "
+                      "the cells (fixed number), with the refined share + "
+                      "Coarsen fraction <= 1; 0 = no coarsening "
+                      "(quadrilaterals only: deal.II 9.4 cannot coarsen "
+                      "triangles).");
     prm.declare_entry("Minimum growth",
                       "1",
                       Double(1, 4),
@@ -454,25 +485,72 @@ namespace membranes::Parameters
   Refinement::parse_parameters(ParameterHandler &prm)
   {
     prm.enter_subsection("Refinement");
-    strategy       = selected(prm, "Refinement/Strategy", strategies);
-    cycles         = prm.get_integer("Cycles");
-    marking        = selected(prm, "Refinement/Marking", markings);
-    bulk_parameter = get_double(prm, "Refinement", "Bulk parameter");
-    if (!(bulk_parameter > 0))
-      throw invalid_entry("Refinement/Bulk parameter",
-                          prm.get("Bulk parameter"),
-                          "the share must be in (0, 1]");
+    strategy = selected(prm, "Refinement/Strategy", strategies);
+    cycles   = prm.get_integer("Cycles");
+    parse_marking(prm);
     coarsen_fraction = get_double(prm, "Refinement", "Coarsen fraction");
     // Shares of the same cells (or of the same η²), at its two ends.
-    if (bulk_parameter + coarsen_fraction > 1)
+    if (refined_share() + coarsen_fraction > 1)
       throw invalid_entry("Refinement/Coarsen fraction",
                           prm.get("Coarsen fraction"),
-                          "Bulk parameter + Coarsen fraction must be <= 1");
+                          (marking == Marking::bulk ? "Bulk parameter" :
+                                                      "Refinement fraction") +
+                            std::string(" + Coarsen fraction must be <= 1"));
     minimum_growth   = get_double(prm, "Refinement", "Minimum growth");
     max_dofs         = prm.get_integer("Max dofs");
     estimator        = selected(prm, "Refinement/Estimator", estimators);
     target_estimator = get_double(prm, "Refinement", "Target estimator");
     prm.leave_subsection();
+  }
+
+
+
+  void
+  Refinement::parse_marking(ParameterHandler &prm)
+  {
+    if (prm.get("Marking") == former_fixed_number)
+      throw invalid_entry(
+        "Refinement/Marking",
+        former_fixed_number,
+        "write 'fixed number' to refine the share 'Refinement fraction' of "
+        "the cells with the largest indicators (deal.II's "
+        "refine_and_coarsen_fixed_number), or 'bulk' for the bulk criterion "
+        "with 'Bulk parameter' (Doerfler marking, which deal.II calls "
+        "refine_and_coarsen_fixed_fraction)");
+    marking = selected(prm, "Refinement/Marking", markings);
+    for (const auto &[entry, share, default_value, used] :
+         {std::tuple{"Bulk parameter",
+                     &bulk_parameter,
+                     default_bulk_parameter,
+                     marking == Marking::bulk},
+          std::tuple{"Refinement fraction",
+                     &refinement_fraction,
+                     default_refinement_fraction,
+                     marking == Marking::fixed_number}})
+      {
+        *share = get_double(prm, "Refinement", entry);
+        if (!(*share > 0))
+          throw invalid_entry(std::string("Refinement/") + entry,
+                              prm.get(entry),
+                              "the share must be in (0, 1]");
+        // The share of the other marking, set: the scene meant this one.
+        if (!used && *share != std::stod(default_value))
+          throw invalid_entry(
+            std::string("Refinement/") + entry,
+            prm.get(entry),
+            std::string("it sets the share of Marking = ") +
+              (marking == Marking::bulk ?
+                 "fixed number; Marking = bulk refines the share 'Bulk "
+                 "parameter' of the squared estimator" :
+                 "bulk; Marking = fixed number refines the share "
+                 "'Refinement fraction' of the cells"));
+      }
+  }
+
+  double
+  Refinement::refined_share() const
+  {
+    return marking == Marking::bulk ? bulk_parameter : refinement_fraction;
   }
 
 

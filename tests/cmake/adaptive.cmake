@@ -109,7 +109,7 @@ membranes_scene_test(minimum_growth slit.prm EXPECTED
            Output/Write\ vtu=false
   CHECKS --growth cells>=2.45 --dof-rate err_energy>=0.4)
 
-# Case M, adaptive, both cell types; on quadrilaterals with fixed-fraction
+# Case M, adaptive, both cell types; on quadrilaterals with fixed-number
 # marking and coarsening too (catches coarsening that transfers the
 # solution wrongly: the iterations and values move).
 foreach(cell_type quadrilateral triangle)
@@ -122,6 +122,6 @@ endforeach()
 membranes_scene_test(case_m_adaptive_coarsening case-m-quadrilateral.prm
   EXPECTED
   SETTINGS Refinement/Strategy=adaptive Refinement/Cycles=12
-           Refinement/Marking=fixed\ fraction Refinement/Bulk\ parameter=0.3
+           Refinement/Marking=fixed\ number Refinement/Refinement\ fraction=0.3
            Refinement/Coarsen\ fraction=0.05 Output/Write\ vtu=false
   CHECKS --band effectivity<=2 --hanging-nodes 3 ${NESTED_ITERATION})

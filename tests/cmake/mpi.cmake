@@ -144,12 +144,12 @@ membranes_process_comparison(mpi_symmetric_p1_residual case-m-triangle.prm 8
 membranes_process_comparison(mpi_symmetric_p1_flux case-m-triangle.prm 8
   SOLVER direct RTOL 1e-10 Refinement/Strategy=adaptive
   Refinement/Estimator=flux Output/Flux\ reconstruction=true)
-membranes_process_comparison(mpi_symmetric_p1_fixed_fraction
+membranes_process_comparison(mpi_symmetric_p1_fixed_number
   case-m-triangle.prm 7 Refinement/Strategy=adaptive
-  Refinement/Marking=fixed\ fraction Solver/Tolerance=1e-12)
-membranes_process_comparison(mpi_symmetric_q1_fixed_fraction
+  Refinement/Marking=fixed\ number Solver/Tolerance=1e-12)
+membranes_process_comparison(mpi_symmetric_q1_fixed_number
   case-m-quadrilateral.prm 7 Refinement/Strategy=adaptive
-  Refinement/Marking=fixed\ fraction
+  Refinement/Marking=fixed\ number
   Refinement/Estimator=flux Output/Flux\ reconstruction=true
   Solver/Tolerance=1e-12)
 

@@ -16,9 +16,11 @@ namespace membranes
    * mesh those of the locally owned cells, on a mesh that every process
    * holds whole those of all cells, the same on every process).
    *
-   * With `Marking = bulk` (Dörfler) the refined cells are the fewest, of
-   * the largest indicators, whose η_K² sum up to the share @p top of
-   * η² = Σ_K η_K²; with `fixed fraction` they are the share @p top of the
+   * With `Marking = bulk` (Dörfler marking, deal.II's
+   * `refine_and_coarsen_fixed_fraction`) the refined cells are the fewest,
+   * of the largest indicators, whose η_K² sum up to the share @p top of
+   * η² = Σ_K η_K²; with `fixed number` (deal.II's
+   * `refine_and_coarsen_fixed_number`) they are the share @p top of the
    * cells with the largest indicators. Coarsening takes the share
    * @p bottom at the small end likewise, never a cell flagged for
    * refinement. Both sets are the cells above (below) a threshold, so a
@@ -32,8 +34,9 @@ namespace membranes
    * symmetric scene many cells carry indicators that are equal in exact
    * arithmetic, and a marking that cuts through such a group by the order
    * of their computed values would pick different cells of it on
-   * different partitions, and from then on build different meshes. Here the thresholds are made independent of the
-   * partition, and the cut cannot fall inside a group of ties:
+   * different partitions, and from then on build different meshes. Here the
+   * thresholds are made independent of the partition, and the cut cannot fall
+   * inside a group of ties:
    *
    * - one process gathers the indicators of all cells, sorts them, and
    *   finds the share @p top (@p bottom) in this order, which does not

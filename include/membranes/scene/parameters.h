@@ -247,10 +247,16 @@ namespace membranes::Parameters
     adaptive
   };
 
+  /**
+   * The marking of adaptive refinement, by deal.II's names: the bulk
+   * criterion (Dörfler marking, deal.II's
+   * `refine_and_coarsen_fixed_fraction`), or a fixed share of the cells
+   * (`refine_and_coarsen_fixed_number`).
+   */
   enum class Marking
   {
-    bulk,
-    fixed_fraction
+    bulk,        ///< The fewest cells that hold the share θ of η².
+    fixed_number ///< The share of the cells with the largest η_K.
   };
 
   enum class Estimator
@@ -262,13 +268,14 @@ namespace membranes::Parameters
   /** Subsection `Refinement`: the sequence of meshes of one run. */
   struct Refinement
   {
-    RefinementStrategy strategy;   ///< Global or adaptive refinement.
-    unsigned int       cycles;     ///< Number of meshes (cycles) of the run.
-    Marking            marking;    ///< Dörfler (bulk) or fixed fraction.
-    double       bulk_parameter;   ///< θ: share of η² (bulk) or of cells.
-    double       coarsen_fraction; ///< The same for coarsening; 0 = none.
-    double       minimum_growth;   ///< Least growth factor of the cells.
-    unsigned int max_dofs;         ///< Stop before exceeding; 0 = no limit.
+    RefinementStrategy strategy; ///< Global or adaptive refinement.
+    unsigned int       cycles;   ///< Number of meshes (cycles) of the run.
+    Marking            marking;  ///< Bulk (Dörfler) or fixed number.
+    double       bulk_parameter; ///< θ: the share of η² of bulk marking.
+    double       refinement_fraction; ///< The share of cells of fixed number.
+    double       coarsen_fraction;    ///< The same at the small end; 0 = none.
+    double       minimum_growth;      ///< Least growth factor of the cells.
+    unsigned int max_dofs;            ///< Stop before exceeding; 0 = no limit.
     Estimator    estimator;        ///< Which a posteriori estimator drives it.
     double       target_estimator; ///< Stop once η <= this; 0 = no target.
 
@@ -276,6 +283,21 @@ namespace membranes::Parameters
     declare_parameters(ParameterHandler &prm);
     void
     parse_parameters(ParameterHandler &prm);
+
+    /**
+     * The share that the marking refines: `Bulk parameter` (of η²) or
+     * `Refinement fraction` (of the cells).
+     */
+    double
+    refined_share() const;
+
+  private:
+    /**
+     * `Marking` and its share; the former name `fixed fraction`, and the
+     * share of the other marking set, refused.
+     */
+    void
+    parse_marking(ParameterHandler &prm);
   };
 
   /** Subsection `Output`: what a run writes, and where. */
