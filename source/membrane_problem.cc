@@ -487,9 +487,13 @@ namespace membranes
    * indicators of all cells: each process contributes those of its own
    * cells (the others are zero) and the sum is the same vector everywhere,
    * so every process flags the same cells.
+   *
+   * If every indicator is zero (the estimator finds the discrete solution
+   * exact), no cell can be marked: the run says so and ends (false)
+   * instead of repeating the mesh.
    */
   template <int dim>
-  void
+  bool
   MembraneProblem<dim>::refine_grid()
   {
     const auto &refinement = parameters.refinement;
@@ -506,6 +510,14 @@ namespace membranes
       }
     if (refinement.strategy == Parameters::RefinementStrategy::global)
       triangulation->set_all_refine_flags();
+    else if (Utilities::MPI::max(indicators.linfty_norm(), mpi_communicator) ==
+             0)
+      {
+        pcout << "Stopping: every refinement indicator is zero (the discrete "
+                 "solution is exact for the estimator), no cell to refine"
+              << std::endl;
+        return false;
+      }
     else
       {
         mark_cells(*triangulation,
@@ -561,6 +573,7 @@ namespace membranes
       }
     triangulation->execute_coarsening_and_refinement();
     complete_ghost_layer(*triangulation);
+    return true;
   }
 
 
@@ -708,8 +721,8 @@ namespace membranes
           // Making the mesh of this cycle from the last one is part of its
           // cost.
           TimerOutput::Scope scope(computing_timer, "setup");
-          if (cycle > 0)
-            refine_grid();
+          if (cycle > 0 && !refine_grid())
+            break;
           setup_system();
           if (exceeds_max_dofs(cycle))
             break;

@@ -103,7 +103,7 @@ namespace membranes
     output_results(const unsigned int cycle);
     bool
     target_reached() const;
-    void
+    bool
     refine_grid();
     TimeRecord
     phase_times() const;

@@ -421,7 +421,10 @@ namespace membranes::Parameters
                       "'Refinement fraction' of the cells, those with the "
                       "largest indicators. 'fixed fraction' is refused with "
                       "what to write instead: this entry once used it for "
-                      "fixed number.");
+                      "fixed number. Where every indicator is zero (the "
+                      "estimator finds the discrete solution exact) no "
+                      "cell is marked: the run says so in one line and "
+                      "ends after that cycle.");
     prm.declare_entry("Bulk parameter",
                       default_bulk_parameter,
                       Double(0, 1),

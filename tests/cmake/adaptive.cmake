@@ -125,3 +125,21 @@ membranes_scene_test(case_m_adaptive_coarsening case-m-quadrilateral.prm
            Refinement/Marking=fixed\ number Refinement/Refinement\ fraction=0.3
            Refinement/Coarsen\ fraction=0.05 Output/Write\ vtu=false
   CHECKS --band effectivity<=2 --hanging-nodes 3 ${NESTED_ITERATION})
+
+# A discrete solution that is exact (tests/scenes/flat-membranes.prm: flat
+# membranes without load), so that every indicator is zero: the run says so
+# in one line and ends after the first cycle instead of repeating its mesh,
+# on one process with bulk marking and on two (triangles, fixed number,
+# the flux estimator). Catches: cycles that repeat the same mesh, or a
+# decision that differs between processes.
+membranes_scene_test(exact_discrete_solution
+  ${CMAKE_CURRENT_SOURCE_DIR}/scenes/flat-membranes.prm
+  CHECKS --rows 1 --max estimator<=0)
+membranes_scene_test(exact_discrete_solution_np2
+  ${CMAKE_CURRENT_SOURCE_DIR}/scenes/flat-membranes.prm PROCESSES 2
+  SETTINGS Geometry/Cell\ type=triangle Refinement/Marking=fixed\ number
+           Refinement/Estimator=flux
+  CHECKS --rows 1 --max flux_estimator<=0)
+set_tests_properties(exact_discrete_solution.run exact_discrete_solution_np2.run
+  PROPERTIES PASS_REGULAR_EXPRESSION
+  "\nStopping: every refinement indicator is zero [^\n]*no cell to refine\n")

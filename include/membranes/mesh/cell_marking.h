@@ -21,7 +21,8 @@ namespace membranes
    * of the largest indicators, whose η_K² sum up to the share @p top of
    * η² = Σ_K η_K²; with `fixed number` (deal.II's
    * `refine_and_coarsen_fixed_number`) they are the share @p top of the
-   * cells with the largest indicators. Coarsening takes the share
+   * cells with the largest indicators. If every indicator is zero, no cell
+   * is refined (nor, with bulk marking, coarsened). Coarsening takes the share
    * @p bottom at the small end likewise, never a cell flagged for
    * refinement. Both sets are the cells above (below) a threshold, so a
    * larger share contains a smaller one.
