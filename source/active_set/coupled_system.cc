@@ -54,10 +54,8 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::setup(
-    const DiscreteProblem<dim>      &problem,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints)
+  CoupledSystem<dim>::setup(const DiscreteProblem<dim> &problem,
+                            const DoFHandler<dim>      &dof_handler)
   {
     block_indices.reinit(2, dof_handler.n_dofs());
     const IndexSet owned    = system_unknowns(problem.locally_owned_dofs());
@@ -69,13 +67,7 @@ namespace membranes
     mesh_constraints.reinit(relevant);
     for (unsigned int i = 0; i < 2; ++i)
       {
-        AffineConstraints<double> membrane_constraints;
-        problem.make_constraints(dof_handler,
-                                 hanging_node_constraints,
-                                 i == 0 ? 1 : 0,
-                                 i == 0 ? 0 : 1,
-                                 membrane_constraints);
-        for (const auto &line : membrane_constraints.get_lines())
+        for (const auto &line : problem.constraints(i).get_lines())
           {
             const auto row = block_indices.local_to_global(i, line.index);
             mesh_constraints.add_line(row);
@@ -214,10 +206,9 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
-                               const DoFHandler<dim>      &dof_handler,
-                               const IndexSet             &active_set,
-                               BlockVectorType            &solution)
+  CoupledSystem<dim>::set_active_set(const DiscreteProblem<dim> &problem,
+                                     const DoFHandler<dim>      &dof_handler,
+                                     const IndexSet             &active_set)
   {
     constraints.clear();
     constraints.reinit(mesh_constraints.get_local_lines());
@@ -230,9 +221,6 @@ namespace membranes
         }
     constraints.merge(mesh_constraints);
     constraints.close();
-    copy_to_system(solution);
-    constraints.distribute(system_solution);
-    copy_from_system(solution);
     assemble_system(problem, dof_handler);
     scaling = tension_scaling(problem, active_set);
   }
@@ -248,6 +236,7 @@ namespace membranes
   {
     VectorType &x = system_solution;
     copy_to_system(solution);
+    constraints.set_zero(x);
     if (this->linear_solver.is_direct())
       this->linear_solver.solve_direct(system_matrix, x, system_rhs);
     else

@@ -21,7 +21,7 @@ namespace membranes
    * On active vertices the contact constraint u1(a) = u2(a) is a line of an
    * AffineConstraints object in this numbering, merged with the hanging
    * node constraints and the boundary values u1 = g_h, u2 = g2_h of each
-   * block (built once per mesh). Every iteration assembles its system anew in a
+   * block (those of DiscreteProblem, built once per mesh). Every iteration assembles its system anew in a
    * loop over the cells, each cell's matrix (block diagonal, μ_i A_K on
    * membrane i) and loads F_iK (computed once per mesh,
    * DiscreteProblem::cell_loads()) condensed by distribute_local_to_global with
@@ -53,25 +53,22 @@ namespace membranes
                   const MPI_Comm             mpi_communicator);
 
     /**
-     * The hanging node and boundary constraints of both blocks, sparsity
-     * pattern and matrix for @p dof_handler; the pattern has room for any
-     * active set.
+     * The constraints of both membranes of @p problem in the numbering of
+     * the system, sparsity pattern and matrix for @p dof_handler; the
+     * pattern has room for any active set.
      */
     void
-    setup(const DiscreteProblem<dim>      &problem,
-          const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints) override;
+    setup(const DiscreteProblem<dim> &problem,
+          const DoFHandler<dim>      &dof_handler) override;
 
     /**
      * The constraints of @p active_set (its contact lines merged with the
-     * constraints of the mesh), set in @p solution, and the system
-     * assembled with them.
+     * constraints of the mesh), and the system assembled with them.
      */
     void
-    assemble(const DiscreteProblem<dim> &problem,
-             const DoFHandler<dim>      &dof_handler,
-             const IndexSet             &active_set,
-             BlockVectorType            &solution) override;
+    set_active_set(const DiscreteProblem<dim> &problem,
+                   const DoFHandler<dim>      &dof_handler,
+                   const IndexSet             &active_set) override;
 
     void
     solve(const DiscreteProblem<dim> &problem,
