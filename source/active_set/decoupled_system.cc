@@ -1,5 +1,4 @@
 #include <deal.II/lac/linear_operator.h>
-#include <deal.II/lac/trilinos_index_access.h>
 #include <membranes/active_set/decoupled_system.h>
 
 namespace membranes
@@ -39,51 +38,30 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::make_obstacle_matrix(const DiscreteProblem<dim> &problem,
-                                             const IndexSet &active_set)
+  DecoupledSystem<dim>::make_obstacle_matrix(
+    const DiscreteProblem<dim> &problem,
+    const IndexSet             &active_set)
   {
     // μ̄ A with the rows and columns of the active vertices eliminated, as
     // AffineConstraints condenses the lines W_a = 0 in a cell loop (step-41):
     // zero off the diagonal, and on it the sum μ̄ Σ_K A_K(a, a) = μ̄ ∫|∇φ_a|²
-    // of the cell matrices. The matrix of the mesh is condensed with the
-    // hanging node and boundary constraints already, so that eliminating
-    // the active rows and columns from it gives the same matrix without
-    // recomputing a cell matrix. Epetra's row views make it one pass over
-    // the locally owned entries.
+    // of the cell matrices. A is condensed with the hanging node and
+    // boundary constraints already, so that eliminating the active rows
+    // and columns from it gives that matrix without a cell matrix.
+    const double mu_bar = this->data.mu_bar;
     obstacle_matrix.copy_from(problem.laplace_matrix());
-    obstacle_matrix *= this->data.mu_bar;
-    // Epetra's row views point into the values of the matrix.
-    const Epetra_CrsMatrix &matrix = obstacle_matrix.trilinos_matrix();
-    const auto       &columns = matrix.ColMap();
-    std::vector<char> active_column(columns.NumMyElements(), false);
-    for (const auto dof : active_set)
-      {
-        const int column =
-          columns.LID(static_cast<TrilinosWrappers::types::int_type>(dof));
-        if (column >= 0)
-          active_column[column] = true;
-      }
-    const auto &vertices = problem.vertices();
-    auto        vertex   = vertices.begin();
-    for (int row = 0; row < matrix.NumMyRows(); ++row)
-      {
-        const types::global_dof_index dof =
-          TrilinosWrappers::global_index(matrix.RowMap(), row);
-        while (vertex != vertices.end() && vertex->dof < dof)
-          ++vertex;
-        const bool active_row = active_set.is_element(dof);
-        int        n_entries;
-        double    *values;
-        int       *indices;
-        matrix.ExtractMyRowView(row, n_entries, values, indices);
-        for (int e = 0; e < n_entries; ++e)
-          if (active_row || active_column[indices[e]])
-            values[e] =
-              (static_cast<types::global_dof_index>(
-                 TrilinosWrappers::global_index(columns, indices[e])) == dof) ?
-                this->data.mu_bar * vertex->stiffness_diagonal :
-                0;
-      }
+    obstacle_matrix *= mu_bar;
+    this->for_each_row(problem,
+                       obstacle_matrix,
+                       active_set,
+                       [mu_bar](
+                         const typename ActiveSetSystem<dim>::MatrixRow &row) {
+                         for (int e = 0; e < row.n_entries; ++e)
+                           if (row.active || row.active_column(e))
+                             row.values[e] = (row.column(e) == row.dof) ?
+                                               mu_bar * row.stiffness_diagonal :
+                                               0;
+                       });
   }
 
 
@@ -94,16 +72,23 @@ namespace membranes
                                        const DoFHandler<dim> &,
                                        const IndexSet &active_set)
   {
-    // Π, 1 at the inactive vertices and 0 at the active ones, as a diagonal
-    // matrix. The matrix of W is made anew when the direct solver
+    // Π, 1 at the inactive vertices and 0 at the active ones, and I − Π, as
+    // diagonal matrices. The matrix of W is made anew when the direct solver
     // factorizes it or when the AMG hierarchy is built from it.
     VectorType &inactive = inactive_projection.get_vector();
+    VectorType &active   = active_projection.get_vector();
     inactive.reinit(problem.loads(0), true);
+    active.reinit(problem.loads(0), true);
     inactive = 1;
+    active   = 0;
     for (const auto dof : active_set)
       if (inactive.in_local_range(dof))
-        inactive[dof] = 0;
+        {
+          inactive[dof] = 0;
+          active[dof]   = 1;
+        }
     inactive.compress(VectorOperation::insert);
+    active.compress(VectorOperation::insert);
     if (this->linear_solver.is_direct() ||
         !this->linear_solver.has_preconditioner())
       make_obstacle_matrix(problem, active_set);
@@ -181,8 +166,9 @@ namespace membranes
           this->linear_solver.initialize_preconditioner(obstacle_matrix);
         const auto &A  = problem.laplace_matrix();
         const auto  Pi = linear_operator<VectorType>(A, inactive_projection);
-        const auto  I_minus_Pi = identity_operator(Pi) - Pi;
-        const auto  op =
+        const auto  I_minus_Pi =
+          linear_operator<VectorType>(A, active_projection);
+        const auto op =
           Pi * (this->data.mu_bar * linear_operator<VectorType>(A)) * Pi +
           I_minus_Pi;
         const auto amg =
@@ -219,7 +205,10 @@ namespace membranes
   {
     this->linear_solver.clear();
     obstacle_matrix.clear();
-    for (VectorType *vector : {&s, &w, &inactive_projection.get_vector()})
+    for (VectorType *vector : {&s,
+                               &w,
+                               &inactive_projection.get_vector(),
+                               &active_projection.get_vector()})
       vector->clear();
   }
 

@@ -35,10 +35,10 @@ namespace membranes
                          const ActiveSet<dim>                     &active_set,
                          const TrilinosWrappers::MPI::BlockVector &solution)
   {
-    const double max = std::numeric_limits<double>::max();
+    const double max     = std::numeric_limits<double>::max();
     KKTDefects  &defects = *this;
     min_w = min_lambda = min_contact_force = max;
-    const auto  &vertices = problem.vertices();
+    const auto &vertices                   = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
         const auto  &a             = vertices[k];

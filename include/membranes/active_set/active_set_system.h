@@ -7,6 +7,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <functional>
 #include <membranes/active_set/active_set_solver.h>
 #include <membranes/active_set/linear_solver.h>
 #include <membranes/mesh/discrete_problem.h>
@@ -98,6 +99,37 @@ namespace membranes
     description() const;
 
   protected:
+    /**
+     * One locally owned row of a matrix with the sparsity pattern of the
+     * Laplacian A of the mesh (DiscreteProblem::laplace_matrix()), seen
+     * with an active set: its DoF, whether that is an active vertex and,
+     * if so, ∫|∇φ_a|² of the vertex, and Epetra's view of its entries.
+     */
+    struct MatrixRow
+    {
+      types::global_dof_index dof;
+      bool                    active;
+      double                  stiffness_diagonal;
+      int                     n_entries;
+      double                 *values;
+      /** The DoF of entry @p e and whether it is an active vertex. */
+      std::function<types::global_dof_index(int)> column;
+      std::function<bool(int)>                    active_column;
+    };
+
+    /**
+     * @p row_function for each locally owned row of @p matrix (a copy of
+     * the Laplacian of @p problem, or the Laplacian itself) with the
+     * locally relevant active vertices @p active_set: one pass over the
+     * locally stored entries by Epetra's row views, which point into the
+     * values of the matrix.
+     */
+    static void
+    for_each_row(const DiscreteProblem<dim>                   &problem,
+                 const TrilinosWrappers::SparseMatrix         &matrix,
+                 const IndexSet                               &active_set,
+                 const std::function<void(const MatrixRow &)> &row_function);
+
     ActiveSetSystem(const std::string         &method,
                     const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,

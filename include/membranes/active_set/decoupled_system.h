@@ -163,8 +163,11 @@ namespace membranes
      */
     VectorType s;
     VectorType w;
-    /** Π of the active set of the last set_active_set(). */
-    DiagonalMatrix<VectorType> inactive_projection;
+    /**
+     * Π and I − Π of the active set of the last set_active_set() (1 at the
+     * inactive, resp. active, vertices).
+     */
+    DiagonalMatrix<VectorType> inactive_projection, active_projection;
     /** Whether S has been solved for on this mesh. */
     bool s_solved;
 
