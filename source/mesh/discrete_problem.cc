@@ -201,8 +201,8 @@ namespace membranes
     const VectorType                &stiffness_diagonal)
   {
     // 1/‖A_a‖₁ of the locally owned rows of A, by Epetra's own inverse row
-    // sums of absolute values (benchmarks/README.md, "Choices measured in
-    // the code", says why not deal.II's row iterator).
+    // sums of absolute values (benchmarks/README.md, "The matrices of an
+    // active set from the mesh's A", says why not deal.II's row iterator).
     VectorType inverse_row_l1_norm(owned_dofs, mpi_communicator);
     AssertThrow(matrix.trilinos_matrix().InvRowSums(
                   *inverse_row_l1_norm.trilinos_vector()(0)) == 0,

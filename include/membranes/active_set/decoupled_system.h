@@ -70,9 +70,9 @@ namespace membranes
    * active vertices to zero, a deal.II LinearOperator composed of the
    * matrix A of the mesh and the diagonal matrices Π and I − Π. The AMG
    * hierarchy does need a matrix, and the right one: the hierarchy of A
-   * itself, seen through Π, preconditions the operator poorly
-   * (benchmarks/README.md measures it), because the restriction of A⁻¹ to
-   * the inactive vertices is not the inverse of the restriction of A. So
+   * itself, seen through Π, preconditions the operator poorly, because the
+   * restriction of A⁻¹ to the inactive vertices is not the inverse of the
+   * restriction of A. So
    * the first iteration of a mesh (and one whose CG iterations exceed twice
    * those of the one that built the hierarchy, plus rebuild_slack)
    * makes the matrix of W, the condensation of step-41 done on the

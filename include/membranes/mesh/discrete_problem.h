@@ -86,7 +86,7 @@ namespace membranes
       /**
        * Σ_b |A_ab|, the l1 norm of the row of a in A (condensed with the
        * hanging node constraints and the boundary values): half of it is
-       * the divisor of the projected Jacobi sweeps of ActiveSet.
+       * the divisor of the projected Jacobi sweeps of ActiveSetPrediction.
        */
       double stiffness_row_l1_norm;
     };
