@@ -109,13 +109,12 @@ namespace membranes
 
     dual_mesh.reinit(dof_handler);
     discrete_problem.reinit(dof_handler,
+                            locally_relevant_dofs,
                             hanging_node_constraints,
                             dual_mesh,
                             mpi_communicator);
     action.reinit(discrete_problem);
-    active_set_solver.setup(discrete_problem,
-                            dof_handler,
-                            hanging_node_constraints);
+    active_set_solver.setup(discrete_problem, dof_handler);
 
     const IndexSet &owned = discrete_problem.locally_owned_dofs();
     solution.reinit(std::vector<IndexSet>(2, owned), mpi_communicator);
@@ -196,7 +195,7 @@ namespace membranes
    */
   template <int dim>
   SolveRecord
-  MembraneProblem<dim>::solve()
+  MembraneProblem<dim>::solve(KKTDefects &defects)
   {
     ActiveSetStatistics statistics;
     const double        expected_error =
@@ -221,6 +220,7 @@ namespace membranes
           "; " + write_unconverged_iterate());
       }
     ghosted_solution = solution;
+    defects          = statistics.kkt_defects;
 
     return {statistics.iterations,
             active_set.n_active_vertices(),
@@ -241,22 +241,14 @@ namespace membranes
    */
   template <int dim>
   IdentityRecord
-  MembraneProblem<dim>::postprocess()
+  MembraneProblem<dim>::postprocess(const KKTDefects &defects)
   {
     lambda_h = action.lambda_h(discrete_problem, hanging_node_constraints);
 
-    const KKTDefects defects =
-      active_set.kkt_defects(discrete_problem, action, solution);
     const double force_scale =
       std::max(action.force_scale(), std::numeric_limits<double>::min());
     const double u_scale = displacement_scale(ghosted_solution);
-    // The active set lives on V_h only: no hanging vertex is ever active.
-    unsigned int hanging_active = 0;
-    for (const auto dof : active_set.locally_owned())
-      if (hanging_node_constraints.is_constrained(dof))
-        ++hanging_active;
-    return {Utilities::MPI::sum(hanging_active, mpi_communicator),
-            defects.min_w,
+    return {defects.min_w,
             defects.min_lambda,
             defects.sum_equilibrium / force_scale,
             defects.complementarity / (force_scale * u_scale)};
@@ -434,7 +426,7 @@ namespace membranes
                dof_handler,
                ghosted_solution,
                lambda_h,
-               active_set.locally_owned(),
+               active_set.locally_owned(discrete_problem),
                nullptr);
     return "the last iterate is in " + output.directory + " (" + files[0] +
            ", " + files[1] + "), not in the report";
@@ -456,7 +448,7 @@ namespace membranes
                        dof_handler,
                        ghosted_solution,
                        lambda_h,
-                       active_set.locally_owned(),
+                       active_set.locally_owned(discrete_problem),
                        indicators.size() ? &indicators : nullptr);
     if (parameters.output.flux_reconstruction && parameters.output.write_vtu)
       field_output.write_dual_mesh(cycle,
@@ -730,10 +722,11 @@ namespace membranes
         }
         record_mesh(cycle);
 
-        record.solve = solve();
+        KKTDefects defects;
+        record.solve = solve(defects);
         {
           TimerOutput::Scope scope(computing_timer, "postprocess");
-          record.identities = postprocess();
+          record.identities = postprocess(defects);
         }
         record.errors    = compute_errors();
         record.estimator = estimate_error();

@@ -24,9 +24,7 @@ with the tolerances of the column's kind:
 kind                       rtol       atol   columns
 =========================  =========  =====  ================================
 counts                     0          0      cycle, cells, dofs, levels,
-                                             active_vertices,
-                                             hanging_active_vertices,
-                                             processes
+                                             active_vertices, processes
 iterations                 0          1      active_set_iterations
 values                     1e-6       0      errors, estimators and their
                                              parts, effectivities
@@ -74,7 +72,7 @@ from check_report import ReportError, parse_number, read_csv
 PROG = "check_expected.py"
 
 COUNTS = ("cycle", "cells", "dofs", "levels", "active_vertices",
-          "hanging_active_vertices", "processes")
+          "processes")
 VALUES = ("err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2", "err_energy",
           "estimator", "effectivity", "flux_estimator", "flux_effectivity",
           "flux_estimator_flux", "flux_estimator_oscillation",

@@ -38,8 +38,7 @@ report is compared as its kind in REPORT_COLUMNS says, with R = ``--rtol``
 and F = ``--factor`` (default 10):
 
 ``count``, a = b
-    cycle, cells, dofs, levels, active_set_iterations, active_vertices,
-    hanging_active_vertices.
+    cycle, cells, dofs, levels, active_set_iterations, active_vertices.
 ``value``, |a - b| <= R max(|a|, |b|)
     The errors, the estimators and their effectivities, the flux, the
     oscillation and the boundary data parts of the flux estimator,
@@ -99,8 +98,7 @@ COUNT, VALUE, CONTACT, ROUND_OFF, IDENTITY, VARIES, COST = (
 # --report: the kind of every column of report.csv (module docstring).
 REPORT_COLUMNS = {
     **dict.fromkeys(("cycle", "cells", "dofs", "levels",
-                     "active_set_iterations", "active_vertices",
-                     "hanging_active_vertices"), COUNT),
+                     "active_set_iterations", "active_vertices"), COUNT),
     **dict.fromkeys(("err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2",
                      "err_lambda_L2", "err_lambda_L2_omega_h",
                      "err_lambda_Hm1", "err_energy",

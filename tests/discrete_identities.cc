@@ -250,12 +250,13 @@ namespace
 
       dual_mesh.reinit(dof_handler);
       discrete_problem.reinit(dof_handler,
+                              relevant_dofs,
                               constraints,
                               dual_mesh,
                               mpi_communicator);
       action.reinit(discrete_problem);
       active_set.reinit(discrete_problem);
-      solver.setup(discrete_problem, dof_handler, constraints);
+      solver.setup(discrete_problem, dof_handler);
 
       solution.reinit(std::vector<IndexSet>(2, owned_dofs), mpi_communicator);
       ghosted_solution.reinit(std::vector<IndexSet>(2, owned_dofs),

@@ -86,9 +86,9 @@ namespace membranes
     void
     transfer_solution();
     SolveRecord
-    solve();
+    solve(KKTDefects &defects);
     IdentityRecord
-    postprocess();
+    postprocess(const KKTDefects &defects);
     std::optional<ErrorRecord>
     compute_errors();
     bool

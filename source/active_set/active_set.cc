@@ -19,9 +19,27 @@ namespace membranes
   void
   ActiveSetHistory::restart(const IndexSet &initial_active_set)
   {
-    visited          = {initial_active_set};
+    visited          = {fingerprint(initial_active_set)};
     n_cycles         = 0;
     least_index_rule = false;
+  }
+
+
+
+  std::uint64_t
+  ActiveSetHistory::fingerprint(const IndexSet &set) const
+  {
+    // splitmix64's finalizer: a 64-bit hash of each DoF, summed modulo 2^64
+    // (unsigned arithmetic), so that the sum depends on the set only.
+    std::uint64_t sum = 0;
+    for (const auto dof : set)
+      {
+        std::uint64_t x = dof + 0x9e3779b97f4a7c15ull;
+        x               = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+        x               = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+        sum += x ^ (x >> 31);
+      }
+    return Utilities::MPI::sum(sum, mpi_communicator);
   }
 
 
@@ -29,10 +47,11 @@ namespace membranes
   std::optional<unsigned int>
   ActiveSetHistory::find(const IndexSet &set) const
   {
-    for (unsigned int i = 0; i < visited.size(); ++i)
-      if (Utilities::MPI::min(visited[i] == set ? 1 : 0, mpi_communicator) == 1)
-        return i;
-    return std::nullopt;
+    const auto position =
+      std::find(visited.begin(), visited.end(), fingerprint(set));
+    if (position == visited.end())
+      return std::nullopt;
+    return position - visited.begin();
   }
 
 
@@ -100,7 +119,7 @@ namespace membranes
             step.least_index_rule = true;
           }
       }
-    visited.push_back(step.active_set);
+    visited.push_back(fingerprint(step.active_set));
     return step;
   }
 
@@ -130,29 +149,6 @@ namespace membranes
 
 
 
-  double
-  KKTDefects::relative_residual(const double force_scale,
-                                const double contact_force_scale,
-                                const double displacement_scale) const
-  {
-    return std::max(
-      {sum_equilibrium / force_scale,
-       contact_equilibrium / contact_force_scale,
-       std::max(0., -min_w) / displacement_scale,
-       std::max(0., -min_contact_force) / contact_force_scale,
-       complementarity / (contact_force_scale * displacement_scale)});
-  }
-
-
-
-  double
-  displacement_scale(const TrilinosWrappers::MPI::BlockVector &solution)
-  {
-    return std::max(solution.linfty_norm(), std::numeric_limits<double>::min());
-  }
-
-
-
   template <int dim>
   ActiveSet<dim>::ActiveSet(const Parameters::Solver &parameters,
                             const ProblemData<dim>   &data,
@@ -169,8 +165,11 @@ namespace membranes
   void
   ActiveSet<dim>::reinit(const DiscreteProblem<dim> &discrete_problem)
   {
-    active_vertices = IndexSet(discrete_problem.locally_owned_dofs().size());
     active_flags.assign(discrete_problem.vertices().size(), false);
+    partitioner = std::make_shared<Utilities::MPI::Partitioner>(
+      discrete_problem.locally_owned_dofs(),
+      discrete_problem.locally_relevant_dofs(),
+      mpi_communicator);
   }
 
 
@@ -187,44 +186,32 @@ namespace membranes
     const auto  &vertices = discrete_problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto  &a      = vertices[k];
-        const double c      = contact_stiffness(a);
-        const double lambda = ghosted_lambda_h[a.dof] / (c * u_scale);
-        const double w      = discrete_problem.nodal_w(k, solution) / u_scale;
+        const double lambda = ghosted_lambda_h[vertices[k].dof];
+        const double w      = discrete_problem.nodal_w(k, solution);
         const bool   degenerate =
-          std::abs(lambda) <= epsilon && std::abs(w) <= epsilon;
-        if (!degenerate && lambda - w > 0)
-          active_vertices.add_index(a.dof);
-      }
-    active_vertices.compress();
-    set_flags(discrete_problem);
-  }
-
-
-
-  template <int dim>
-  void
-  ActiveSet<dim>::set_flags(const DiscreteProblem<dim> &problem)
-  {
-    // Both are sorted by the DoF.
-    const auto &vertices = problem.vertices();
-    auto        active   = active_vertices.begin();
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
+          std::abs(lambda / (contact_stiffness(vertices[k]) * u_scale)) <=
+            epsilon &&
+          std::abs(w / u_scale) <= epsilon;
         active_flags[k] =
-          (active != active_vertices.end() && *active == vertices[k].dof);
-        if (active_flags[k])
-          ++active;
+          !degenerate &&
+          violation(discrete_problem, k, lambda, w, u_scale) > 0;
       }
   }
 
 
 
   template <int dim>
-  const IndexSet &
-  ActiveSet<dim>::locally_owned() const
+  IndexSet
+  ActiveSet<dim>::locally_owned(const DiscreteProblem<dim> &problem) const
   {
-    return active_vertices;
+    std::vector<types::global_dof_index> dofs;
+    for (unsigned int k = 0; k < active_flags.size(); ++k)
+      if (active_flags[k])
+        dofs.push_back(problem.vertices()[k].dof);
+    IndexSet set(problem.locally_owned_dofs().size());
+    set.add_indices(dofs.begin(), dofs.end());
+    set.compress();
+    return set;
   }
 
 
@@ -233,7 +220,9 @@ namespace membranes
   types::global_dof_index
   ActiveSet<dim>::n_active_vertices() const
   {
-    return Utilities::MPI::sum(active_vertices.n_elements(), mpi_communicator);
+    return Utilities::MPI::sum<types::global_dof_index>(
+      std::count(active_flags.begin(), active_flags.end(), true),
+      mpi_communicator);
   }
 
 
@@ -242,19 +231,31 @@ namespace membranes
   IndexSet
   ActiveSet<dim>::locally_relevant(const DiscreteProblem<dim> &problem) const
   {
-    VectorType owned_flags(problem.locally_owned_dofs(), mpi_communicator);
-    for (const auto dof : active_vertices)
-      owned_flags[dof] = 1;
-    owned_flags.compress(VectorOperation::insert);
-    VectorType flags(problem.locally_owned_dofs(),
-                     problem.locally_relevant_dofs(),
-                     mpi_communicator);
-    flags = owned_flags;
+    // The owners' flags at the ghost DoFs, through the partitioner of the
+    // mesh.
+    std::vector<double> owned(partitioner->locally_owned_size(), 0.),
+      ghosts(partitioner->n_ghost_indices()),
+      buffer(partitioner->n_import_indices());
+    const auto &positions = problem.local_positions();
+    for (unsigned int k = 0; k < active_flags.size(); ++k)
+      owned[positions[k]] = active_flags[k];
+    std::vector<MPI_Request> requests;
+    partitioner->export_to_ghosted_array_start<double>(
+      0,
+      make_array_view(std::as_const(owned)),
+      make_array_view(buffer),
+      make_array_view(ghosts),
+      requests);
+    partitioner->export_to_ghosted_array_finish<double>(make_array_view(ghosts),
+                                                        requests);
 
-    IndexSet relevant_active_set(active_vertices.size());
+    IndexSet relevant_active_set(problem.locally_owned_dofs().size());
     for (const auto dof : problem.locally_relevant_vertices())
-      if (flags[dof] > 0)
-        relevant_active_set.add_index(dof);
+      {
+        const unsigned int p = partitioner->global_to_local(dof);
+        if ((p < owned.size() ? owned[p] : ghosts[p - owned.size()]) > 0)
+          relevant_active_set.add_index(dof);
+      }
     relevant_active_set.compress();
     return relevant_active_set;
   }
@@ -271,49 +272,6 @@ namespace membranes
 
 
   template <int dim>
-  KKTDefects
-  ActiveSet<dim>::kkt_defects(const DiscreteProblem<dim> &problem,
-                              const DiscreteAction<dim>  &action,
-                              const BlockVectorType      &solution) const
-  {
-    const double max = std::numeric_limits<double>::max();
-    KKTDefects   defects{0, 0, max, max, max, 0};
-    const auto  &vertices = problem.vertices();
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const auto  &a             = vertices[k];
-        const double d             = a.dual_cell_measure;
-        const double w             = problem.nodal_w(k, solution);
-        const double lambda        = action.lambda(k);
-        const double contact_force = lambda * d;
-        defects.sum_equilibrium =
-          std::max(defects.sum_equilibrium,
-                   std::abs(action.lambda_from_membrane(0, k) -
-                            action.lambda_from_membrane(1, k)) *
-                     d);
-        if (!is_active(k))
-          defects.contact_equilibrium =
-            std::max(defects.contact_equilibrium, std::abs(contact_force));
-        defects.min_w      = std::min(defects.min_w, w);
-        defects.min_lambda = std::min(defects.min_lambda, lambda);
-        defects.min_contact_force =
-          std::min(defects.min_contact_force, contact_force);
-        defects.complementarity =
-          std::max(defects.complementarity, std::abs(contact_force * w));
-      }
-    for (double *maximum : {&defects.sum_equilibrium,
-                            &defects.contact_equilibrium,
-                            &defects.complementarity})
-      *maximum = Utilities::MPI::max(*maximum, mpi_communicator);
-    for (double *minimum :
-         {&defects.min_w, &defects.min_lambda, &defects.min_contact_force})
-      *minimum = Utilities::MPI::min(*minimum, mpi_communicator);
-    return defects;
-  }
-
-
-
-  template <int dim>
   std::vector<StatusChange>
   ActiveSet<dim>::wanted_changes(const DiscreteProblem<dim> &problem,
                                  const DiscreteAction<dim>  &action,
@@ -322,16 +280,17 @@ namespace membranes
     const double epsilon = parameters.tolerance;
     const double u_scale = displacement_scale(solution);
 
+    // After a solve W_a = 0 on A and λ_a = 0 off A (up to the residual of
+    // the linear solver): the test reads λ_a on A and W_a off A.
     std::vector<StatusChange> changes;
     const auto               &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto  &a = vertices[k];
-        const double violation =
-          is_active(k) ? -action.lambda(k) / (contact_stiffness(a) * u_scale) :
-                         -problem.nodal_w(k, solution) / u_scale;
-        if (violation > epsilon)
-          changes.push_back({a.dof, violation / epsilon});
+        const double v = is_active(k) ?
+                           violation(problem, k, action.lambda(k), 0, u_scale) :
+                           violation(problem, k, 0, problem.nodal_w(k, solution), u_scale);
+        if (v > epsilon)
+          changes.push_back({vertices[k].dof, v / epsilon});
       }
     return changes;
   }
@@ -339,10 +298,25 @@ namespace membranes
 
 
   template <int dim>
-  void
-  ActiveSet<dim>::restart()
+  double
+  ActiveSet<dim>::violation(const DiscreteProblem<dim> &problem,
+                            const unsigned int          k,
+                            const double                lambda,
+                            const double                w,
+                            const double                u_scale) const
   {
-    history.restart(active_vertices);
+    const double c    = contact_stiffness(problem.vertices()[k]);
+    const double test = (lambda - c * w) / (c * u_scale);
+    return is_active(k) ? -test : test;
+  }
+
+
+
+  template <int dim>
+  void
+  ActiveSet<dim>::restart(const DiscreteProblem<dim> &problem)
+  {
+    history.restart(locally_owned(problem));
   }
 
 
@@ -352,9 +326,18 @@ namespace membranes
   ActiveSet<dim>::update(const DiscreteProblem<dim>      &problem,
                          const std::vector<StatusChange> &changes)
   {
-    const ActiveSetHistory::Step step = history.next(active_vertices, changes);
-    active_vertices                   = step.active_set;
-    set_flags(problem);
+    const ActiveSetHistory::Step step =
+      history.next(locally_owned(problem), changes);
+    // step.active_set and the vertices are both sorted by the DoF.
+    const auto &vertices = problem.vertices();
+    auto        active   = step.active_set.begin();
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        active_flags[k] =
+          (active != step.active_set.end() && *active == vertices[k].dof);
+        if (active_flags[k])
+          ++active;
+      }
     return step;
   }
 

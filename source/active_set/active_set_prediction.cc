@@ -42,16 +42,14 @@ namespace membranes
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
     // condensed Laplacian. With S fixed, r_a = μ̄ (A W)_a − b_a, b the
     // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem): one product
-    // with A on the scalar W per sweep, on contiguous local arrays. In the
-    // end U1 moves by μ2/M and U2 by −μ1/M of the change of W.
+    // with A on the scalar W per sweep, on contiguous local arrays. The
+    // predicted iterate is U1 = (S + μ2 W)/M, U2 = (S − μ1 W)/M.
     const double *const lifted_1 = problem.lifted_loads(0).begin();
     const double *const lifted_2 = problem.lifted_loads(1).begin();
-    BlockVectorType     iterate  = solution;
-    VectorType          w        = iterate.block(0);
-    w -= iterate.block(1);
+    VectorType          w(solution.block(0));
+    w -= solution.block(1);
     VectorType          stiffness_w(w);
     double *const       w_values = w.begin();
-    const VectorType    start_w(w);
     std::vector<double> load(vertices.size()),
       inverse_diagonal(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
@@ -72,10 +70,14 @@ namespace membranes
             w_values[p] = std::max(0., w_values[p] - r * inverse_diagonal[k]);
           }
       }
-    VectorType &step = w;
-    step -= start_w;
-    iterate.block(0).add(mu2 / M, step);
-    iterate.block(1).add(-mu1 / M, step);
+    BlockVectorType iterate;
+    iterate.reinit(solution, true);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        iterate.block(i).equ(mu1 / M, solution.block(0));
+        iterate.block(i).add(mu2 / M, solution.block(1));
+        iterate.block(i).add(i == 0 ? mu2 / M : -mu1 / M, w);
+      }
     predicted_action.compute(problem, iterate);
 
     // The test Λ_a − c_a W_a > 0 on the predicted iterate, with the band of
@@ -83,15 +85,15 @@ namespace membranes
     std::vector<StatusChange> changes;
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto  &a = vertices[k];
-        const double c = active_set.contact_stiffness(a);
-        const double test =
-          (predicted_action.lambda(k) - c * problem.nodal_w(k, iterate)) /
-          (c * u_scale);
-        const double violation = active_set.is_active(k) ? -test : test;
+        const auto  &a         = vertices[k];
+        const double violation = active_set.violation(problem,
+                                                      k,
+                                                      predicted_action.lambda(k),
+                                                      problem.nodal_w(k, iterate),
+                                                      u_scale);
         if (violation > epsilon)
           changes.push_back({a.dof, violation / epsilon});
-        else if (std::abs(test) <= epsilon)
+        else if (std::abs(violation) <= epsilon)
           {
             // The prediction is indifferent here: the plain test decides.
             const auto plain =

@@ -82,13 +82,11 @@ namespace membranes
 
   template <int dim>
   void
-  ActiveSetSolver<dim>::setup(
-    const DiscreteProblem<dim>      &discrete_problem,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints)
+  ActiveSetSolver<dim>::setup(const DiscreteProblem<dim> &discrete_problem,
+                              const DoFHandler<dim>      &dof_handler)
   {
     prediction.reinit(discrete_problem);
-    system->setup(discrete_problem, dof_handler, hanging_node_constraints);
+    system->setup(discrete_problem, dof_handler);
 
     // The constants of balanced stopping: C_F of the bounding box of the
     // mesh, c_M of the lumped mass, and d_min.
@@ -144,9 +142,8 @@ namespace membranes
                                  Statistics                 &statistics) const
   {
     const double tiny = std::numeric_limits<double>::min();
-    statistics.kkt_residual =
-      active_set.kkt_defects(problem, action, solution)
-        .relative_residual(std::max(action.force_scale(), tiny),
+    statistics.kkt_defects = KKTDefects(problem, action, active_set, solution);
+    statistics.kkt_residual = statistics.kkt_defects.relative_residual(std::max(action.force_scale(), tiny),
                            std::max(action.contact_force_scale(), tiny),
                            displacement_scale(solution));
     if (stopping.balanced)
@@ -370,16 +367,15 @@ namespace membranes
   {
     Statistics    statistics;
     StoppingState stopping = start(expected_error);
-    active_set.restart();
+    active_set.restart(problem);
     for (statistics.iterations = 1;; ++statistics.iterations)
       {
         const unsigned int linear_iterations = statistics.linear_iterations;
         {
           TimerOutput::Scope scope(timer, "assembly");
-          system->assemble(problem,
-                           dof_handler,
-                           active_set.locally_relevant(problem),
-                           solution);
+          system->set_active_set(problem,
+                                 dof_handler,
+                                 active_set.locally_relevant(problem));
         }
         TimerOutput::Scope scope(timer, "solve");
         // The forces of the initial guess set the tolerances of the first

@@ -1,3 +1,6 @@
+#include <Epetra_Import.h>
+#include <Epetra_Vector.h>
+#include <deal.II/lac/trilinos_index_access.h>
 #include <membranes/active_set/active_set_system.h>
 
 namespace membranes
@@ -23,6 +26,63 @@ namespace membranes
   ActiveSetSystem<dim>::description() const
   {
     return method + ", " + linear_solver.method();
+  }
+
+
+
+  template <int dim>
+  void
+  ActiveSetSystem<dim>::for_each_row(
+    const DiscreteProblem<dim>                   &problem,
+    const TrilinosWrappers::SparseMatrix         &matrix,
+    const IndexSet                               &active_set,
+    const std::function<void(const MatrixRow &)> &row_function)
+  {
+    // The status of the vertex of every column: the owners' flags imported
+    // by the matrix's own importer, for the columns of a row can reach
+    // beyond the locally relevant DoFs (through the hanging node
+    // constraints of a ghost cell).
+    const Epetra_CrsMatrix &epetra_matrix = matrix.trilinos_matrix();
+    const auto             &columns       = epetra_matrix.ColMap();
+    const auto             &owned         = epetra_matrix.DomainMap();
+    Epetra_Vector           owned_flags(owned), column_flags(columns);
+    for (const auto dof : active_set)
+      {
+        const int p =
+          owned.LID(static_cast<TrilinosWrappers::types::int_type>(dof));
+        if (p >= 0)
+          owned_flags[p] = 1;
+      }
+    if (epetra_matrix.Importer() != nullptr)
+      column_flags.Import(owned_flags, *epetra_matrix.Importer(), Insert);
+    else
+      column_flags = owned_flags;
+    std::vector<char> active_columns(columns.NumMyElements());
+    for (int c = 0; c < columns.NumMyElements(); ++c)
+      active_columns[c] = (column_flags[c] > 0);
+
+    // The rows and the vertices of V_h are both sorted by the DoF.
+    const auto &vertices = problem.vertices();
+    auto        vertex   = vertices.begin();
+    MatrixRow   row;
+    int        *indices;
+    row.column = [&](const int e) -> types::global_dof_index {
+      return TrilinosWrappers::global_index(columns, indices[e]);
+    };
+    row.active_column = [&](const int e) -> bool {
+      return active_columns[indices[e]];
+    };
+    for (int r = 0; r < epetra_matrix.NumMyRows(); ++r)
+      {
+        row.dof = TrilinosWrappers::global_index(epetra_matrix.RowMap(), r);
+        while (vertex != vertices.end() && vertex->dof < row.dof)
+          ++vertex;
+        row.active             = active_columns[columns.LID(
+          static_cast<TrilinosWrappers::types::int_type>(row.dof))];
+        row.stiffness_diagonal = row.active ? vertex->stiffness_diagonal : 0;
+        epetra_matrix.ExtractMyRowView(r, row.n_entries, row.values, indices);
+        row_function(row);
+      }
   }
 
 

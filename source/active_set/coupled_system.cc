@@ -6,7 +6,6 @@
 #include <deal.II/lac/linear_operator.h>
 #include <deal.II/lac/sparsity_tools.h>
 #include <membranes/active_set/coupled_system.h>
-#include <membranes/mesh/cell_system.h>
 
 namespace membranes
 {
@@ -54,10 +53,8 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::setup(
-    const DiscreteProblem<dim>      &problem,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints)
+  CoupledSystem<dim>::setup(const DiscreteProblem<dim> &problem,
+                            const DoFHandler<dim>      &dof_handler)
   {
     block_indices.reinit(2, dof_handler.n_dofs());
     const IndexSet owned    = system_unknowns(problem.locally_owned_dofs());
@@ -69,13 +66,7 @@ namespace membranes
     mesh_constraints.reinit(relevant);
     for (unsigned int i = 0; i < 2; ++i)
       {
-        AffineConstraints<double> membrane_constraints;
-        problem.make_constraints(dof_handler,
-                                 hanging_node_constraints,
-                                 i == 0 ? 1 : 0,
-                                 i == 0 ? 0 : 1,
-                                 membrane_constraints);
-        for (const auto &line : membrane_constraints.get_lines())
+        for (const auto &line : problem.constraints(i).get_lines())
           {
             const auto row = block_indices.local_to_global(i, line.index);
             mesh_constraints.add_line(row);
@@ -159,35 +150,72 @@ namespace membranes
   template <int dim>
   void
   CoupledSystem<dim>::assemble_system(const DiscreteProblem<dim> &problem,
-                                      const DoFHandler<dim>      &dof_handler)
+                                      const IndexSet             &active_set)
   {
-    CellSystem<dim>    cell_system(this->discretization, this->data);
-    const unsigned int n_vertices = cell_system.dof_indices.size();
-    FullMatrix<double> cell_matrix(2 * n_vertices);
-    Vector<double>     cell_rhs(2 * n_vertices);
-    std::vector<types::global_dof_index> indices;
+    // The block diagonal system of μ1 A and μ2 A with the lifted loads,
+    // condensed with the contact lines u1(a) = u2(a) as AffineConstraints
+    // condenses them in a cell loop (step-41): the equation of u1 at an
+    // active vertex added to that of u2, the column of u1(a) to that of
+    // u2(a), and μ1 ∫|∇φ_a|² left alone on the diagonal of u1(a). A is
+    // condensed with the hanging node and boundary constraints already, so
+    // that this gives the system of a cell loop without a cell matrix.
+    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const auto   u1 = [this](const types::global_dof_index dof) {
+      return block_indices.local_to_global(0, dof);
+    };
+    const auto u2 = [this](const types::global_dof_index dof) {
+      return block_indices.local_to_global(1, dof);
+    };
     system_matrix = 0;
-    system_rhs    = 0;
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        {
-          // Block diagonal: μ_i A_K and F_iK on membrane i.
-          cell_system.reinit_operator(cell);
-          cell_system.set_loads(problem.cell_loads(cell));
-          for (unsigned int i = 0; i < 2; ++i)
-            for (unsigned int v = 0; v < n_vertices; ++v)
-              {
-                for (unsigned int w = 0; w < n_vertices; ++w)
-                  cell_matrix(i * n_vertices + v, i * n_vertices + w) =
-                    this->data.mu[i] * cell_system.laplace_matrix(v, w);
-                cell_rhs(i * n_vertices + v) = cell_system.loads[i](v);
-              }
-          get_system_indices(cell_system.dof_indices, indices);
-          constraints.distribute_local_to_global(
-            cell_matrix, cell_rhs, indices, system_matrix, system_rhs);
-        }
+    std::array<std::vector<types::global_dof_index>, 2> columns;
+    std::array<std::vector<double>, 2>                  values;
+    this->for_each_row(
+      problem,
+      problem.laplace_matrix(),
+      active_set,
+      [&](const typename ActiveSetSystem<dim>::MatrixRow &row) {
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            columns[i].clear();
+            values[i].clear();
+          }
+        // The equation of membrane 1 in the row of u1, or of u2 if active.
+        const unsigned int row_1 = row.active ? 1 : 0;
+        for (int e = 0; e < row.n_entries; ++e)
+          {
+            const auto dof = row.column(e);
+            columns[row_1].push_back(row.active_column(e) ? u2(dof) : u1(dof));
+            values[row_1].push_back(mu1 * row.values[e]);
+            columns[1].push_back(u2(dof));
+            values[1].push_back(mu2 * row.values[e]);
+          }
+        if (row.active)
+          {
+            columns[0] = {u1(row.dof)};
+            values[0]  = {mu1 * row.stiffness_diagonal};
+          }
+        for (unsigned int i = 0; i < 2; ++i)
+          system_matrix.add(block_indices.local_to_global(i, row.dof),
+                            columns[i].size(),
+                            columns[i].data(),
+                            values[i].data(),
+                            false);
+      });
     system_matrix.compress(VectorOperation::add);
-    system_rhs.compress(VectorOperation::add);
+
+    // The loads, those of u1 at an active vertex added to those of u2.
+    const unsigned int  n_owned  = problem.locally_owned_dofs().n_elements();
+    const double *const lifted_1 = problem.lifted_loads(0).begin();
+    const double *const lifted_2 = problem.lifted_loads(1).begin();
+    std::copy_n(lifted_1, n_owned, system_rhs.begin());
+    std::copy_n(lifted_2, n_owned, system_rhs.begin() + n_owned);
+    for (unsigned int k = 0; k < problem.vertices().size(); ++k)
+      if (active_set.is_element(problem.vertices()[k].dof))
+        {
+          const unsigned int p = problem.local_positions()[k];
+          system_rhs.begin()[n_owned + p] += lifted_1[p];
+          system_rhs.begin()[p] = 0;
+        }
   }
 
 
@@ -214,10 +242,9 @@ namespace membranes
 
   template <int dim>
   void
-  CoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
-                               const DoFHandler<dim>      &dof_handler,
-                               const IndexSet             &active_set,
-                               BlockVectorType            &solution)
+  CoupledSystem<dim>::set_active_set(const DiscreteProblem<dim> &problem,
+                                     const DoFHandler<dim>      &dof_handler,
+                                     const IndexSet             &active_set)
   {
     constraints.clear();
     constraints.reinit(mesh_constraints.get_local_lines());
@@ -230,10 +257,7 @@ namespace membranes
         }
     constraints.merge(mesh_constraints);
     constraints.close();
-    copy_to_system(solution);
-    constraints.distribute(system_solution);
-    copy_from_system(solution);
-    assemble_system(problem, dof_handler);
+    assemble_system(problem, active_set);
     scaling = tension_scaling(problem, active_set);
   }
 
@@ -248,6 +272,7 @@ namespace membranes
   {
     VectorType &x = system_solution;
     copy_to_system(solution);
+    constraints.set_zero(x);
     if (this->linear_solver.is_direct())
       this->linear_solver.solve_direct(system_matrix, x, system_rhs);
     else

@@ -1,7 +1,5 @@
 #include <deal.II/lac/linear_operator.h>
 #include <membranes/active_set/decoupled_system.h>
-#include <membranes/mesh/cell_loop.h>
-#include <membranes/mesh/cell_system.h>
 
 namespace membranes
 {
@@ -24,33 +22,15 @@ namespace membranes
 
   template <int dim>
   void
-  DecoupledSystem<dim>::setup(
-    const DiscreteProblem<dim>      &problem,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints)
+  DecoupledSystem<dim>::setup(const DiscreteProblem<dim> &problem,
+                              const DoFHandler<dim> &)
   {
-    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    problem.make_constraints(
-      dof_handler, hanging_node_constraints, mu1, mu2, s_constraints);
-    problem.make_constraints(
-      dof_handler, hanging_node_constraints, 1, -1, w_constraints);
     // The constants are the near null space of the Laplacian.
     this->linear_solver.reinit(
-      dof_handler.n_dofs(),
+      problem.laplace_matrix().m(),
       {std::vector<bool>(problem.locally_owned_dofs().n_elements(), true)});
-
-    // The right-hand sides of S and W: the loads lifted by the boundary
-    // values of each membrane combine into those lifted by the boundary
-    // values of S and W, the lifting being linear in both.
-    s_rhs = problem.lifted_loads(0);
-    s_rhs += problem.lifted_loads(1);
-    w_rhs.reinit(s_rhs);
-    w_rhs.add(mu2 / (mu1 + mu2),
-              problem.lifted_loads(0),
-              -mu1 / (mu1 + mu2),
-              problem.lifted_loads(1));
-    s.reinit(s_rhs);
-    w.reinit(s_rhs);
+    s.reinit(problem.loads(0));
+    w.reinit(problem.loads(0));
     s_solved = false;
   }
 
@@ -60,78 +40,45 @@ namespace membranes
   void
   DecoupledSystem<dim>::make_obstacle_matrix(
     const DiscreteProblem<dim> &problem,
-    const DoFHandler<dim>      &dof_handler,
     const IndexSet             &active_set)
   {
-    // The constraints W_a = 0 of the active vertices (locally relevant)
-    // merged with those of the mesh, condensed by distribute_local_to_global
-    // as step-41 condenses its active set: the rows and columns of the
-    // active vertices eliminated.
-    const double              coefficient = this->data.mu_bar;
-    AffineConstraints<double> constraints(problem.locally_relevant_dofs());
-    for (const auto dof : active_set)
-      constraints.add_line(dof);
-    constraints.merge(w_constraints,
-                      AffineConstraints<double>::right_object_wins);
-    constraints.close();
-
-    struct CellMatrix
-    {
-      FullMatrix<double>                   matrix;
-      std::vector<types::global_dof_index> dof_indices;
-    };
-    obstacle_matrix.reinit(problem.laplace_matrix());
-    run_on_cells<CellMatrix>(
-      dof_handler,
-      [&]() {
-        return std::make_unique<CellSystem<dim>>(this->discretization,
-                                                 this->data);
-      },
-      [&](const auto &cell, CellSystem<dim> &cell_system, CellMatrix &copy) {
-        copy.dof_indices.clear();
-        if (!cell->is_locally_owned())
-          return;
-        cell_system.reinit_operator(cell);
-        copy.matrix = cell_system.laplace_matrix;
-        copy.matrix *= coefficient;
-        copy.dof_indices = cell_system.dof_indices;
-      },
-      [&](const CellMatrix &copy) {
-        if (!copy.dof_indices.empty())
-          constraints.distribute_local_to_global(copy.matrix,
-                                                 copy.dof_indices,
-                                                 obstacle_matrix);
-      });
-    obstacle_matrix.compress(VectorOperation::add);
+    // μ̄ A with the rows and columns of the active vertices eliminated, as
+    // AffineConstraints condenses the lines W_a = 0 in a cell loop (step-41):
+    // zero off the diagonal, and on it the sum μ̄ Σ_K A_K(a, a) = μ̄ ∫|∇φ_a|²
+    // of the cell matrices. A is condensed with the hanging node and
+    // boundary constraints already, so that eliminating the active rows
+    // and columns from it gives that matrix without a cell matrix.
+    const double mu_bar = this->data.mu_bar;
+    obstacle_matrix.copy_from(problem.laplace_matrix());
+    obstacle_matrix *= mu_bar;
+    this->for_each_row(problem,
+                       obstacle_matrix,
+                       active_set,
+                       [mu_bar](
+                         const typename ActiveSetSystem<dim>::MatrixRow &row) {
+                         for (int e = 0; e < row.n_entries; ++e)
+                           if (row.active || row.active_column(e))
+                             row.values[e] = (row.column(e) == row.dof) ?
+                                               mu_bar * row.stiffness_diagonal :
+                                               0;
+                       });
   }
 
 
 
   template <int dim>
   void
-  DecoupledSystem<dim>::assemble(const DiscreteProblem<dim> &problem,
-                                 const DoFHandler<dim>      &dof_handler,
-                                 const IndexSet             &active_set,
-                                 BlockVectorType            &solution)
+  DecoupledSystem<dim>::set_active_set(const DiscreteProblem<dim> &problem,
+                                       const DoFHandler<dim> &,
+                                       const IndexSet &active_set)
   {
-    // On the first iteration of a mesh: S and W of the initial guess.
-    if (!s_solved)
-      {
-        s.equ(this->data.mu[0], solution.block(0));
-        s.add(this->data.mu[1], solution.block(1));
-        w.equ(1., solution.block(0));
-        w.add(-1., solution.block(1));
-        s_constraints.distribute(s);
-      }
-
     // Π, 1 at the inactive vertices and 0 at the active ones, and I − Π, as
-    // diagonal matrices; W = 0 at the active vertices, and the right-hand
-    // side too. The matrix of W is condensed anew when the direct solver
+    // diagonal matrices. The matrix of W is made anew when the direct solver
     // factorizes it or when the AMG hierarchy is built from it.
     VectorType &inactive = inactive_projection.get_vector();
     VectorType &active   = active_projection.get_vector();
-    inactive.reinit(w, true);
-    active.reinit(w, true);
+    inactive.reinit(problem.loads(0), true);
+    active.reinit(problem.loads(0), true);
     inactive = 1;
     active   = 0;
     for (const auto dof : active_set)
@@ -142,13 +89,9 @@ namespace membranes
         }
     inactive.compress(VectorOperation::insert);
     active.compress(VectorOperation::insert);
-    rhs = w_rhs;
-    rhs.scale(inactive);
-    w.scale(inactive);
-    w_constraints.distribute(w);
     if (this->linear_solver.is_direct() ||
         !this->linear_solver.has_preconditioner())
-      make_obstacle_matrix(problem, dof_handler, active_set);
+      make_obstacle_matrix(problem, active_set);
   }
 
 
@@ -156,13 +99,21 @@ namespace membranes
   template <int dim>
   void
   DecoupledSystem<dim>::solve_s(const DiscreteProblem<dim> &problem,
+                                const BlockVectorType      &solution,
                                 const double                tolerance,
                                 ActiveSetStatistics        &statistics)
   {
+    // A S = F_1 + F_2 with the lifted loads, from S = μ1 U1 + μ2 U2 of the
+    // initial guess, its constrained entries zero as the solution's are.
+    VectorType rhs(problem.lifted_loads(0));
+    rhs += problem.lifted_loads(1);
+    s.equ(this->data.mu[0], solution.block(0));
+    s.add(this->data.mu[1], solution.block(1));
+    problem.constraints(0).set_zero(s);
     const TrilinosWrappers::SparseMatrix &laplace_matrix =
       problem.laplace_matrix();
     if (this->linear_solver.is_direct())
-      this->linear_solver.solve_direct(laplace_matrix, s, s_rhs);
+      this->linear_solver.solve_direct(laplace_matrix, s, rhs);
     else
       {
         this->linear_solver.initialize_preconditioner(laplace_matrix);
@@ -170,11 +121,10 @@ namespace membranes
           this->linear_solver.solve_cg(laplace_matrix,
                                        this->linear_solver.preconditioner(),
                                        s,
-                                       s_rhs,
+                                       rhs,
                                        tolerance);
         this->linear_solver.clear();
       }
-    s_constraints.distribute(s);
     s_solved = true;
   }
 
@@ -188,8 +138,22 @@ namespace membranes
                               ActiveSetStatistics        &statistics)
   {
     if (!s_solved)
-      solve_s(problem, tolerances.sum, statistics);
+      solve_s(problem, solution, tolerances.sum, statistics);
 
+    // The obstacle problem for W: from W = U1 − U2 of the iterate, zero at
+    // the active vertices and at the constrained DoFs, with the right-hand
+    // side (μ2 F_1 − μ1 F_2)/M of the lifted loads, zero at the active
+    // vertices (the lifting being linear in the boundary values of both
+    // membranes, it is that by the boundary values g − g2 of W).
+    const double mu1 = this->data.mu[0], mu2 = this->data.mu[1];
+    const double M = mu1 + mu2;
+    VectorType   rhs(problem.lifted_loads(0));
+    rhs.sadd(mu2 / M, -mu1 / M, problem.lifted_loads(1));
+    rhs.scale(inactive_projection.get_vector());
+    w.equ(1., solution.block(0));
+    w.add(-1., solution.block(1));
+    w.scale(inactive_projection.get_vector());
+    problem.constraints(0).set_zero(w);
     if (this->linear_solver.is_direct())
       this->linear_solver.solve_direct(obstacle_matrix, w, rhs);
     else
@@ -217,12 +181,10 @@ namespace membranes
         else if (iterations > 2 * hierarchy_iterations + rebuild_slack)
           this->linear_solver.clear();
       }
-    w_constraints.distribute(w);
 
-    // U1 = (S + μ2 W)/M and U2 = (S − μ1 W)/M, entry by entry: S, W and
-    // both blocks of the solution have the layout of the mesh's vectors.
-    const double        mu1 = this->data.mu[0], mu2 = this->data.mu[1];
-    const double        M        = mu1 + mu2;
+    // U1 = (S + μ2 W)/M and U2 = (S − μ1 W)/M at the unconstrained DoFs,
+    // entry by entry (S, W and both blocks of the solution have the layout
+    // of the mesh's vectors), and the constraints of each membrane.
     const double *const s_values = s.begin(), *const w_values = w.begin();
     double *const u1 = solution.block(0).begin();
     double *const u2 = solution.block(1).begin();
@@ -231,6 +193,8 @@ namespace membranes
         u1[p] = (s_values[p] + mu2 * w_values[p]) / M;
         u2[p] = (s_values[p] - mu1 * w_values[p]) / M;
       }
+    for (unsigned int i = 0; i < 2; ++i)
+      problem.constraints(i).distribute(solution.block(i));
   }
 
 
@@ -241,16 +205,11 @@ namespace membranes
   {
     this->linear_solver.clear();
     obstacle_matrix.clear();
-    for (VectorType *vector : {&s_rhs,
-                               &w_rhs,
-                               &s,
+    for (VectorType *vector : {&s,
                                &w,
-                               &rhs,
                                &inactive_projection.get_vector(),
                                &active_projection.get_vector()})
       vector->clear();
-    s_constraints.clear();
-    w_constraints.clear();
   }
 
 

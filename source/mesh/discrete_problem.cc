@@ -12,33 +12,6 @@
 namespace membranes
 {
   template <int dim>
-  void
-  make_mesh_constraints(
-    const Mapping<dim>              &mapping,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const Function<dim>             &boundary_values,
-    AffineConstraints<double>       &constraints)
-  {
-    constraints.clear();
-    constraints.reinit(hanging_node_constraints.get_local_lines());
-    std::map<types::boundary_id, const Function<dim> *> boundary_functions;
-    for (const auto id : dof_handler.get_triangulation().get_boundary_ids())
-      boundary_functions[id] = &boundary_values;
-    VectorTools::interpolate_boundary_values(mapping,
-                                             dof_handler,
-                                             boundary_functions,
-                                             constraints);
-    // A hanging vertex on ∂ω keeps its hanging node constraint, its value
-    // that of the boundary values of its parents.
-    constraints.merge(hanging_node_constraints,
-                      AffineConstraints<double>::right_object_wins);
-    constraints.close();
-  }
-
-
-
-  template <int dim>
   DiscreteProblem<dim>::DiscreteProblem(
     const Discretization<dim> &discretization,
     const ProblemData<dim>    &data)
@@ -54,22 +27,18 @@ namespace membranes
   void
   DiscreteProblem<dim>::reinit(
     const DoFHandler<dim>           &dof_handler,
+    const IndexSet                  &locally_relevant_dofs,
     const AffineConstraints<double> &hanging_node_constraints,
     const DualMesh<dim>             &dual_mesh,
     const MPI_Comm                   mpi_communicator)
   {
     this->mpi_communicator = mpi_communicator;
     owned_dofs             = dof_handler.locally_owned_dofs();
-    relevant_dofs          = hanging_node_constraints.get_local_lines();
+    relevant_dofs          = locally_relevant_dofs;
+    make_constraints(dof_handler, hanging_node_constraints);
 
-    // Hanging nodes and the boundary values g_1 = g, g_2 = g2 of each
-    // membrane. They constrain the same lines: one pattern, without the
+    // Both membranes constrain the same lines: one pattern, without the
     // rows and columns of constrained DoFs.
-    std::array<AffineConstraints<double>, 2> membrane_constraints;
-    make_constraints(
-      dof_handler, hanging_node_constraints, 1, 0, membrane_constraints[0]);
-    make_constraints(
-      dof_handler, hanging_node_constraints, 0, 1, membrane_constraints[1]);
     DynamicSparsityPattern dsp(relevant_dofs);
     DoFTools::make_sparsity_pattern(dof_handler,
                                     dsp,
@@ -90,7 +59,6 @@ namespace membranes
     VectorType stiffness_diagonal(owned_dofs, mpi_communicator);
     assemble(dof_handler,
              hanging_node_constraints,
-             membrane_constraints,
              dual_cell_measure,
              stiffness_diagonal);
     find_vertices(dual_mesh,
@@ -105,21 +73,39 @@ namespace membranes
   void
   DiscreteProblem<dim>::make_constraints(
     const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const double                     c1,
-    const double                     c2,
-    AffineConstraints<double>       &constraints) const
+    const AffineConstraints<double> &hanging_node_constraints)
   {
-    const ScalarFunctionFromFunctionObject<dim> boundary_values(
-      [this, c1, c2](const Point<dim> &p) {
-        return c1 * data.boundary_values().value(p, 0) +
-               c2 * data.boundary_values().value(p, 1);
-      });
-    make_mesh_constraints(*discretization.mapping,
-                          dof_handler,
-                          hanging_node_constraints,
-                          boundary_values,
-                          constraints);
+    for (unsigned int i = 0; i < 2; ++i)
+      {
+        AffineConstraints<double> &constraints = membrane_constraints[i];
+        constraints.clear();
+        constraints.reinit(relevant_dofs);
+        const ScalarFunctionFromFunctionObject<dim> boundary_values(
+          [this, i](const Point<dim> &p) {
+            return data.boundary_values().value(p, i);
+          });
+        std::map<types::boundary_id, const Function<dim> *> boundary_functions;
+        for (const auto id : dof_handler.get_triangulation().get_boundary_ids())
+          boundary_functions[id] = &boundary_values;
+        VectorTools::interpolate_boundary_values(*discretization.mapping,
+                                                 dof_handler,
+                                                 boundary_functions,
+                                                 constraints);
+        // A hanging vertex on ∂ω keeps its hanging node constraint, its
+        // value that of the boundary values of its parents.
+        constraints.merge(hanging_node_constraints,
+                          AffineConstraints<double>::right_object_wins);
+        constraints.close();
+      }
+  }
+
+
+
+  template <int dim>
+  const AffineConstraints<double> &
+  DiscreteProblem<dim>::constraints(const unsigned int i) const
+  {
+    return membrane_constraints[i];
   }
 
 
@@ -127,11 +113,10 @@ namespace membranes
   template <int dim>
   void
   DiscreteProblem<dim>::assemble(
-    const DoFHandler<dim>                          &dof_handler,
-    const AffineConstraints<double>                &hanging_node_constraints,
-    const std::array<AffineConstraints<double>, 2> &membrane_constraints,
-    VectorType                                     &dual_cell_measure,
-    VectorType                                     &stiffness_diagonal)
+    const DoFHandler<dim>           &dof_handler,
+    const AffineConstraints<double> &hanging_node_constraints,
+    VectorType                      &dual_cell_measure,
+    VectorType                      &stiffness_diagonal)
   {
     // The cell loop on threads: each works with its own CellSystem, the
     // loads of every cell go to that cell's own slot of loads_of_cells, and
@@ -215,13 +200,12 @@ namespace membranes
     const VectorType                &dual_cell_measure,
     const VectorType                &stiffness_diagonal)
   {
-    // The l1 norms of the locally owned rows of A, by Epetra's own row sums
-    // of absolute values (deal.II's row iterator of a Trilinos matrix
-    // resizes its row buffer to n() entries on every row it visits, which
-    // makes a pass over all rows quadratic in the number of DoFs).
-    VectorType row_l1_norm(owned_dofs, mpi_communicator);
+    // 1/‖A_a‖₁ of the locally owned rows of A, by Epetra's own inverse row
+    // sums of absolute values (benchmarks/README.md, "The matrices of an
+    // active set from the mesh's A", says why not deal.II's row iterator).
+    VectorType inverse_row_l1_norm(owned_dofs, mpi_communicator);
     AssertThrow(matrix.trilinos_matrix().InvRowSums(
-                  *row_l1_norm.trilinos_vector()(0)) == 0,
+                  *inverse_row_l1_norm.trilinos_vector()(0)) == 0,
                 ExcInternalError());
 
     // V_h: the unconstrained interior vertices; its owned vertices carry
@@ -237,7 +221,7 @@ namespace membranes
           interior_vertices.push_back({dof,
                                        dual_cell_measure[dof],
                                        stiffness_diagonal[dof],
-                                       1 / row_l1_norm[dof]});
+                                       1 / inverse_row_l1_norm[dof]});
       }
     positions.resize(interior_vertices.size());
     for (unsigned int k = 0; k < interior_vertices.size(); ++k)
@@ -350,11 +334,5 @@ namespace membranes
 
 
 
-  template void
-  make_mesh_constraints(const Mapping<2> &,
-                        const DoFHandler<2> &,
-                        const AffineConstraints<double> &,
-                        const Function<2> &,
-                        AffineConstraints<double> &);
   template class DiscreteProblem<2>;
 } // namespace membranes

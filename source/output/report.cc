@@ -74,7 +74,6 @@ namespace membranes
         {"time_postprocess_s", times.postprocess},
         {"err_energy", error(&ErrorRecord::energy)},
         {"time_estimate_s", times.estimate},
-        {"hanging_active_vertices", identities.hanging_active_vertices, count},
         {"flux_estimator", flux_estimator},
         {"flux_effectivity", effectivity(flux_estimator)},
         {"measure_defect", flux_defect(&FluxRecord::measure_defect)},

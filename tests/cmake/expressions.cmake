@@ -38,7 +38,7 @@ membranes_compare(gradient_exact_vs_differences gradient_exact
 #   both runs bound them by Solver/Tolerance = 1e-10, so they always agree
 #   to 1e-10.)
 set(EVALUATION_VALUES_COLUMNS
-  cycle,cells,dofs,levels,active_set_iterations,active_vertices,hanging_active_vertices,processes,err_u1_L2,err_u2_L2,err_lambda_L2,err_lambda_L2_omega_h,estimator,flux_estimator,flux_estimator_flux,flux_estimator_oscillation,flux_estimator_contact,flux_estimator_boundary,eta_linearization,eta_algebraic)
+  cycle,cells,dofs,levels,active_set_iterations,active_vertices,processes,err_u1_L2,err_u2_L2,err_lambda_L2,err_lambda_L2_omega_h,estimator,flux_estimator,flux_estimator_flux,flux_estimator_oscillation,flux_estimator_contact,flux_estimator_boundary,eta_linearization,eta_algebraic)
 set(EVALUATION_H1_COLUMNS
   err_u1_H1,err_u2_H1,err_energy,effectivity,flux_effectivity)
 set(EVALUATION_ROUND_OFF_COLUMNS

@@ -1,14 +1,16 @@
 #ifndef membranes_active_set_h
 #define membranes_active_set_h
 
-#include <array>
+#include <cstdint>
 #include <deal.II/base/index_set.h>
+#include <deal.II/base/partitioner.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -62,8 +64,15 @@ namespace membranes
    * log2(n) times, so the method terminates on every mesh; a cycle costs
    * iterations, not convergence.
    *
-   * Under MPI each process keeps the locally owned part of the sets; the
-   * comparisons and the choice of vertices are global.
+   * A visited set is remembered by its fingerprint, the sum over its DoFs
+   * of a 64-bit hash of each (modulo 2^64, over all processes: one
+   * reduction per set), not by a copy: two different sets share a
+   * fingerprint with probability about 2^{-64}, and if they did, the
+   * remedy would only restrict one update more than needed, which costs
+   * iterations, not termination.
+   *
+   * Under MPI each process passes the locally owned part of the sets; the
+   * fingerprints and the choice of vertices are global.
    */
   class ActiveSetHistory
   {
@@ -113,65 +122,19 @@ namespace membranes
             const std::vector<types::global_dof_index> &dofs);
 
   private:
-    /** The number of the visited set equal to @p set (on all processes). */
+    /** The fingerprint of @p set (locally owned part), over all processes. */
+    std::uint64_t
+    fingerprint(const IndexSet &set) const;
+
+    /** The number of the visited set with the fingerprint of @p set. */
     std::optional<unsigned int>
     find(const IndexSet &set) const;
 
-    const MPI_Comm        mpi_communicator;
-    std::vector<IndexSet> visited;
+    const MPI_Comm             mpi_communicator;
+    std::vector<std::uint64_t> visited;
     unsigned int          n_cycles;
     bool                  least_index_rule;
   };
-
-
-
-  /**
-   * The defects of the KKT conditions of (3.4) with the multiplier (4.7) of
-   * an iterate, as maxima and minima over the vertices a of V_h (all
-   * processes), in the units of the problem: with W_a = u1h(a) − u2h(a),
-   * λ_a of DiscreteAction::lambda() and d_a,
-   * - Prop. 12 (equilibrium of s): max |λ_1a − λ_2a| d_a;
-   * - equilibrium of w: max |λ_a d_a| on the inactive vertices;
-   * - primal feasibility (W_a ≥ 0): min W_a;
-   * - dual feasibility (λ_a ≥ 0): min λ_a and min λ_a d_a;
-   * - complementarity (4.8): max |λ_a d_a W_a|.
-   * The stopping test of the active set method (relative_residual()) and
-   * the report both read them.
-   */
-  struct KKTDefects
-  {
-    double sum_equilibrium;
-    double contact_equilibrium;
-    double min_w;
-    double min_lambda;
-    double min_contact_force;
-    double complementarity;
-
-    /**
-     * The relative KKT residual, the largest of the defects of the two
-     * problems of DecoupledSystem, each on its own scale: F_∞
-     * (@p force_scale) and F^w_∞ (@p contact_force_scale) of DiscreteAction,
-     * U_∞ = max|U| (@p displacement_scale):
-     * - equilibrium of s / F_∞;
-     * - equilibrium of w / F^w_∞;
-     * - primal feasibility: max(−W_a)⁺ / U_∞;
-     * - dual feasibility: max(−λ_a d_a)⁺ / F^w_∞;
-     * - complementarity / (F^w_∞ U_∞).
-     * All are maxima over the vertices, so none grows with the size of the
-     * mesh, and all are unchanged when the data are scaled or the
-     * membranes swap roles.
-     */
-    double
-    relative_residual(const double force_scale,
-                      const double contact_force_scale,
-                      const double displacement_scale) const;
-  };
-
-
-
-  /** U_∞ = max|U| of @p solution, both blocks (never zero: it divides). */
-  double
-  displacement_scale(const TrilinosWrappers::MPI::BlockVector &solution);
 
 
 
@@ -221,7 +184,11 @@ namespace membranes
    * (ActiveSetPrediction); update() takes whichever it is given, through
    * the remedy against cycling (ActiveSetHistory).
    *
-   * Each process holds the locally owned vertices of A (their DoFs);
+   * Each process holds the status of the locally owned vertices of V_h,
+   * one flag each in the order of DiscreteProblem::vertices(): the one
+   * representation of A, which the loops over the vertices read.
+   * locally_owned() and locally_relevant() derive index sets from it when
+   * the history, the output or the linear systems need one;
    * locally_relevant() tells every process the status of the vertices of
    * its ghost cells, for the constraints of the cells it assembles.
    */
@@ -237,7 +204,10 @@ namespace membranes
               const ProblemData<dim>   &data,
               const MPI_Comm            mpi_communicator);
 
-    /** No active vertex on the mesh of @p discrete_problem (the first mesh). */
+    /**
+     * No active vertex on the mesh of @p discrete_problem (the first mesh),
+     * and the communication pattern of its ghost vertices.
+     */
     void
     reinit(const DiscreteProblem<dim> &discrete_problem);
 
@@ -261,9 +231,10 @@ namespace membranes
       return active_flags[k];
     }
 
-    /** The locally owned active vertices (their DoFs). */
-    const IndexSet &
-    locally_owned() const;
+    /** The locally owned active vertices (their DoFs) of the mesh of
+     * @p problem. */
+    IndexSet
+    locally_owned(const DiscreteProblem<dim> &problem) const;
 
     /** The number of active vertices (all processes). */
     types::global_dof_index
@@ -286,13 +257,18 @@ namespace membranes
     contact_stiffness(const Vertex &a) const;
 
     /**
-     * The KKT defects of the iterate @p solution (locally owned DoFs) with
-     * λ_a in @p action.
+     * The test at the vertex a = @p problem.vertices()[@p k], read with its
+     * status: by how much the iterate with Λ_a = @p lambda and
+     * W_a = @p w, both relative to the data (U_∞ = @p u_scale), asks a to
+     * change its status, λ̂_a − Ŵ_a for an inactive vertex and its negative
+     * for an active one (positive: a change is wanted).
      */
-    KKTDefects
-    kkt_defects(const DiscreteProblem<dim> &problem,
-                const DiscreteAction<dim>  &action,
-                const BlockVectorType      &solution) const;
+    double
+    violation(const DiscreteProblem<dim> &problem,
+              const unsigned int          k,
+              const double                lambda,
+              const double                w,
+              const double                u_scale) const;
 
     /**
      * The locally owned vertices whose status the test wants to change on
@@ -304,9 +280,12 @@ namespace membranes
                    const DiscreteAction<dim>  &action,
                    const BlockVectorType      &solution) const;
 
-    /** Start the record of the sets visited on this mesh (ActiveSetHistory). */
+    /**
+     * Start the record of the sets visited on the mesh of @p problem
+     * (ActiveSetHistory).
+     */
     void
-    restart();
+    restart(const DiscreteProblem<dim> &problem);
 
     /**
      * Move to the next active set after the locally owned vertices
@@ -325,21 +304,14 @@ namespace membranes
     const Parameters::Solver &parameters;
     const ProblemData<dim>   &data;
 
-    /**
-     * active_flags from active_vertices, in one pass over both and the
-     * vertices of @p problem.
-     */
-    void
-    set_flags(const DiscreteProblem<dim> &problem);
-
     const MPI_Comm mpi_communicator;
-    /** The locally owned active vertices. */
-    IndexSet active_vertices;
     /**
-     * The same as one flag per locally owned vertex of V_h, in the order of
-     * DiscreteProblem::vertices(): what the loops over the vertices read.
+     * Whether each locally owned vertex of V_h is active, in the order of
+     * DiscreteProblem::vertices().
      */
     std::vector<char> active_flags;
+    /** The owned and ghost DoFs of the mesh, for locally_relevant(). */
+    std::shared_ptr<const Utilities::MPI::Partitioner> partitioner;
     /** The sets visited on this mesh. */
     ActiveSetHistory history;
   };

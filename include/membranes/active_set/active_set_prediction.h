@@ -37,15 +37,16 @@ namespace membranes
    *   W_a ← max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)),   r_a = λ_a d_a,
    *
    * ‖A_a‖₁ = Σ_b |A_ab| the l1 norm of the row of a in the condensed
-   * Laplacian (one product with A per sweep). Where A is an M-matrix,
-   * ‖A_a‖₁ / 2 = A_aa (its rows sum to zero) and this is plain Jacobi. In
-   * general diag(‖A_a‖₁) − A is weakly diagonally dominant, hence positive
-   * semidefinite, so the sweeps never increase the energy norm of the
-   * error, on any mesh. Plain Jacobi has no such guarantee where A is not
-   * an M-matrix (it diverges on the curved, locally refined cells of the
-   * disk), and l1-Jacobi (the divisor ‖A_a‖₁) takes half this step where A
-   * is an M-matrix, so its prediction lags (benchmarks/README.md compares
-   * both). Each sweep carries the contact information one layer further:
+   * Laplacian (one product with A per sweep). On a row whose entries off
+   * the diagonal are ≤ 0 and sum with it to zero (an interior vertex of a
+   * non-obtuse mesh whose neighbours are not on ∂ω) ‖A_a‖₁ / 2 = A_aa, and
+   * this is plain Jacobi. In general diag(‖A_a‖₁) − A is weakly diagonally
+   * dominant, hence positive semidefinite, so the sweeps never increase the
+   * energy norm of the error, on any mesh; plain Jacobi has no such
+   * guarantee where A has positive entries off the diagonal, and l1-Jacobi
+   * (the divisor ‖A_a‖₁) takes half the step of plain Jacobi on the rows
+   * that sum to zero (benchmarks/README.md, "The prediction of the active
+   * set, before and after", compares the three). Each sweep carries the contact information one layer further:
    * penetrated vertices are clamped and lift their neighbours, active
    * vertices pulled apart are released with the ones behind them. Where the
    * predicted test is within the band of indifference of ActiveSet, the

@@ -7,6 +7,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <membranes/active_set/active_set.h>
 #include <membranes/active_set/active_set_prediction.h>
+#include <membranes/active_set/kkt_defects.h>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
@@ -25,6 +26,7 @@ namespace membranes
     unsigned int iterations        = 0; ///< Active set iterations.
     unsigned int linear_iterations = 0; ///< CG iterations, summed.
     double       kkt_residual      = 0; ///< Relative KKT residual at the end.
+    KKTDefects   kkt_defects;           ///< The KKT defects at the end.
     /**
      * With balanced stopping: the estimates η_lin and η_alg of
      * ActiveSetSolver at the end, in the energy norm.
@@ -175,14 +177,11 @@ namespace membranes
 
     ~ActiveSetSolver();
 
-    /**
-     * The linear systems for the mesh of @p discrete_problem, on
-     * @p dof_handler with @p hanging_node_constraints.
-     */
+    /** The linear systems for the mesh of @p discrete_problem and
+     * @p dof_handler. */
     void
-    setup(const DiscreteProblem<dim>      &discrete_problem,
-          const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints);
+    setup(const DiscreteProblem<dim> &discrete_problem,
+          const DoFHandler<dim>      &dof_handler);
 
     /**
      * Run the active set method on the mesh of @p problem and

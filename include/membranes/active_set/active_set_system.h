@@ -7,6 +7,7 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
+#include <functional>
 #include <membranes/active_set/active_set_solver.h>
 #include <membranes/active_set/linear_solver.h>
 #include <membranes/mesh/discrete_problem.h>
@@ -34,8 +35,8 @@ namespace membranes
    *
    * What does not depend on the active set (the constraints of the mesh,
    * the loads, and for the decoupled system the operator) is built once per
-   * mesh, in setup() or on the first iteration of a mesh; assemble() and
-   * solve() otherwise only do what the active set changes. ActiveSetSolver
+   * mesh, in setup() or on the first iteration of a mesh; set_active_set()
+   * and solve() otherwise only do what the active set changes. ActiveSetSolver
    * times the two in the sections "assembly" and "solve"; solve() adds its
    * CG iterations to the ActiveSetStatistics it is given.
    */
@@ -49,39 +50,34 @@ namespace membranes
     virtual ~ActiveSetSystem() = default;
 
     /**
-     * Matrices, sparsity patterns and the constraints that do not depend on
-     * the active set, for the mesh of @p problem: @p dof_handler with its
-     * @p hanging_node_constraints.
+     * Matrices and sparsity patterns that do not depend on the active set,
+     * for the mesh of @p problem and @p dof_handler.
      */
     virtual void
-    setup(const DiscreteProblem<dim>      &problem,
-          const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints) = 0;
+    setup(const DiscreteProblem<dim> &problem,
+          const DoFHandler<dim>      &dof_handler) = 0;
 
     /**
-     * What the linear problem on the mesh of @p problem and @p dof_handler
-     * for @p active_set (DoFs of the active
-     * locally relevant vertices, ActiveSet::locally_relevant(), so that
-     * every process knows the constraints of the cells it assembles) needs
-     * before its solve: here, not in solve(), the active set is imposed.
+     * Impose @p active_set (DoFs of the active locally relevant vertices,
+     * ActiveSet::locally_relevant(), so that every process knows the
+     * constraints of the cells it assembles) on the linear problem on the
+     * mesh of @p problem and @p dof_handler: here, not in solve().
      * CoupledSystem merges its contact lines u1(a) = u2(a) into
-     * AffineConstraints, sets them in @p solution, the initial guess, and
-     * assembles the condensed system; DecoupledSystem imposes W_a = 0 as
-     * the projection Π of the operator of W (its own vector W and the
-     * right-hand side zeroed at the active vertices), and condenses the
-     * lines W_a = 0 into the matrix of W only when the direct solver or the
-     * AMG setup needs that matrix.
+     * AffineConstraints and assembles the condensed system; DecoupledSystem
+     * imposes W_a = 0 as the projection Π of the operator of W, and
+     * condenses the lines W_a = 0 into the matrix of W only when the direct
+     * solver or the AMG setup needs that matrix.
      */
     virtual void
-    assemble(const DiscreteProblem<dim> &problem,
-             const DoFHandler<dim>      &dof_handler,
-             const IndexSet             &active_set,
-             BlockVectorType            &solution) = 0;
+    set_active_set(const DiscreteProblem<dim> &problem,
+                   const DoFHandler<dim>      &dof_handler,
+                   const IndexSet             &active_set) = 0;
 
     /**
-     * Solve the linear problem of the last assemble(), starting from
-     * @p solution, to the residual norms @p tolerances. On return
-     * @p solution holds (u1h, u2h), constraints included.
+     * Solve the linear problem of the last set_active_set(), starting from
+     * @p solution with its constrained entries set to zero, to the residual
+     * norms @p tolerances. On return @p solution holds (u1h, u2h),
+     * constraints included.
      */
     virtual void
     solve(const DiscreteProblem<dim> &problem,
@@ -103,6 +99,37 @@ namespace membranes
     description() const;
 
   protected:
+    /**
+     * One locally owned row of a matrix with the sparsity pattern of the
+     * Laplacian A of the mesh (DiscreteProblem::laplace_matrix()), seen
+     * with an active set: its DoF, whether that is an active vertex and,
+     * if so, ∫|∇φ_a|² of the vertex, and Epetra's view of its entries.
+     */
+    struct MatrixRow
+    {
+      types::global_dof_index dof;
+      bool                    active;
+      double                  stiffness_diagonal;
+      int                     n_entries;
+      double                 *values;
+      /** The DoF of entry @p e and whether it is an active vertex. */
+      std::function<types::global_dof_index(int)> column;
+      std::function<bool(int)>                    active_column;
+    };
+
+    /**
+     * @p row_function for each locally owned row of @p matrix (a copy of
+     * the Laplacian of @p problem, or the Laplacian itself) with the
+     * locally relevant active vertices @p active_set: one pass over the
+     * locally stored entries by Epetra's row views, which point into the
+     * values of the matrix.
+     */
+    static void
+    for_each_row(const DiscreteProblem<dim>                   &problem,
+                 const TrilinosWrappers::SparseMatrix         &matrix,
+                 const IndexSet                               &active_set,
+                 const std::function<void(const MatrixRow &)> &row_function);
+
     ActiveSetSystem(const std::string         &method,
                     const Parameters::Solver  &parameters,
                     const Discretization<dim> &discretization,

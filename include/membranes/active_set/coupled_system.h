@@ -21,15 +21,16 @@ namespace membranes
    * On active vertices the contact constraint u1(a) = u2(a) is a line of an
    * AffineConstraints object in this numbering, merged with the hanging
    * node constraints and the boundary values u1 = g_h, u2 = g2_h of each
-   * block (built once per mesh). Every iteration assembles its system anew in a
-   * loop over the cells, each cell's matrix (block diagonal, μ_i A_K on
-   * membrane i) and loads F_iK (computed once per mesh,
-   * DiscreteProblem::cell_loads()) condensed by distribute_local_to_global with
-   * these constraints: the equations of u1 and u2 at an active vertex are
-   * added, so the solution of each iteration satisfies Prop. 12 (λ from either
-   * membrane) by construction; on inactive vertices both equations hold, i.e.
-   * λ_a = 0. This is the reference method: clear, and an assembly of the whole
-   * system per iteration (its cost is in benchmarks/README.md).
+   * block (those of DiscreteProblem, built once per mesh). Every iteration
+   * assembles its system anew in a loop over the cells, each cell's matrix
+   * (block diagonal, μ_i A_K on membrane i) and loads F_iK (computed once per
+   * mesh, DiscreteProblem::cell_loads()) condensed by
+   * distribute_local_to_global with these constraints: the equations of u1 and
+   * u2 at an active vertex are added, so the solution of each iteration
+   * satisfies Prop. 12 (λ from either membrane) by construction; on inactive
+   * vertices both equations hold, i.e. λ_a = 0. This is the reference method:
+   * clear, and an assembly of the whole system per iteration (its cost is in
+   * benchmarks/README.md).
    *
    * The rows of the two membranes are forces of tensions μ1 and μ2, and of
    * μ1 + μ2 where the contact constraint adds them: for tension ratios far
@@ -53,25 +54,22 @@ namespace membranes
                   const MPI_Comm             mpi_communicator);
 
     /**
-     * The hanging node and boundary constraints of both blocks, sparsity
-     * pattern and matrix for @p dof_handler; the pattern has room for any
-     * active set.
+     * The constraints of both membranes of @p problem in the numbering of
+     * the system, sparsity pattern and matrix for @p dof_handler; the
+     * pattern has room for any active set.
      */
     void
-    setup(const DiscreteProblem<dim>      &problem,
-          const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints) override;
+    setup(const DiscreteProblem<dim> &problem,
+          const DoFHandler<dim>      &dof_handler) override;
 
     /**
      * The constraints of @p active_set (its contact lines merged with the
-     * constraints of the mesh), set in @p solution, and the system
-     * assembled with them.
+     * constraints of the mesh), and the system assembled with them.
      */
     void
-    assemble(const DiscreteProblem<dim> &problem,
-             const DoFHandler<dim>      &dof_handler,
-             const IndexSet             &active_set,
-             BlockVectorType            &solution) override;
+    set_active_set(const DiscreteProblem<dim> &problem,
+                   const DoFHandler<dim>      &dof_handler,
+                   const IndexSet             &active_set) override;
 
     void
     solve(const DiscreteProblem<dim> &problem,
@@ -105,13 +103,12 @@ namespace membranes
     copy_from_system(BlockVectorType &solution) const;
 
     /**
-     * The system matrix and right-hand side on the mesh of @p problem and
-     * @p dof_handler, assembled cell by cell and condensed with
-     * `constraints`.
+     * The system matrix and right-hand side of @p active_set on the mesh of
+     * @p problem, from its Laplacian and lifted loads.
      */
     void
     assemble_system(const DiscreteProblem<dim> &problem,
-                    const DoFHandler<dim>      &dof_handler);
+                    const IndexSet             &active_set);
 
     /**
      * The diagonal m_j^{-1/2} of the scaling of the system of @p active_set

@@ -49,11 +49,14 @@ namespace membranes
    * condensed with the hanging node constraints and the boundary values,
    * which are the same lines for S and for W), and their right-hand sides
    * are combinations of the lifted loads of the mesh, F_1 + F_2 for S and
-   * (μ2 F_1 − μ1 F_2)/M for W, which setup() forms once per mesh. The first
-   * solve() of a mesh solves A S = F_1 + F_2 from the initial guess. Every
-   * assemble() imposes W_a = 0 on the active set, and every solve() solves
-   * the obstacle problem's linear system for W (inactive vertices:
-   * Λ_a = 0) and writes U1, U2 into the two blocks of the solution.
+   * (μ2 F_1 − μ1 F_2)/M for W. The first solve() of a mesh solves
+   * A S = F_1 + F_2 from the initial guess. Every set_active_set() imposes
+   * W_a = 0 on the active set, and every solve() solves the obstacle
+   * problem's linear system for W (inactive vertices: Λ_a = 0) from the
+   * W of the iterate and writes U1, U2 into the two blocks of the
+   * solution. Both solves start with the constrained entries zero, as the
+   * solution of the condensed system has them (step-55 does the same), and
+   * the constraints of each membrane give U1 and U2 their values there.
    * ActiveSetSolver computes λ_a by (4.5), and ActiveSet the next active
    * set and the KKT residual, from it exactly as for the coupled system:
    * the test Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set
@@ -67,13 +70,14 @@ namespace membranes
    * active vertices to zero, a deal.II LinearOperator composed of the
    * matrix A of the mesh and the diagonal matrices Π and I − Π. The AMG
    * hierarchy does need a matrix, and the right one: the hierarchy of A
-   * itself, seen through Π, preconditions the operator poorly
-   * (benchmarks/README.md measures it), because the restriction of A⁻¹ to
-   * the inactive vertices is not the inverse of the restriction of A. So
+   * itself, seen through Π, preconditions the operator poorly, because the
+   * restriction of A⁻¹ to the inactive vertices is not the inverse of the
+   * restriction of A. So
    * the first iteration of a mesh (and one whose CG iterations exceed twice
    * those of the one that built the hierarchy, plus rebuild_slack)
-   * condenses the matrix of W by AffineConstraints in a cell loop, as
-   * step-41 does, and builds the hierarchy P from it, μ̄ included; CG is
+   * makes the matrix of W, the condensation of step-41 done on the
+   * condensed matrix A of the mesh (make_obstacle_matrix()), and builds the
+   * hierarchy P from it, μ̄ included; CG is
    * preconditioned by Π P Π + (I − Π), and the following iterations, whose
    * active sets differ from it near the free boundary only, reuse P. The
    * direct solver factorizes the matrix of W of every iteration. One matrix
@@ -99,25 +103,19 @@ namespace membranes
                     const ProblemData<dim>    &data,
                     const MPI_Comm             mpi_communicator);
 
-    /**
-     * The constraints of S and of W on @p dof_handler, and the right-hand
-     * sides of both from the lifted loads of @p problem.
-     */
+    /** The vectors S and W on the mesh of @p problem. */
     void
-    setup(const DiscreteProblem<dim>      &problem,
-          const DoFHandler<dim>           &dof_handler,
-          const AffineConstraints<double> &hanging_node_constraints) override;
+    setup(const DiscreteProblem<dim> &problem,
+          const DoFHandler<dim>      &dof_handler) override;
 
     /**
-     * S and W of @p solution on the first iteration of a mesh; the right-hand
-     * side of W for @p active_set, with W = 0 at its vertices, and the
-     * matrix of W when the solve needs it.
+     * The projection Π of @p active_set and, when the solve needs it, the
+     * matrix of W.
      */
     void
-    assemble(const DiscreteProblem<dim> &problem,
-             const DoFHandler<dim>      &dof_handler,
-             const IndexSet             &active_set,
-             BlockVectorType            &solution) override;
+    set_active_set(const DiscreteProblem<dim> &problem,
+                   const DoFHandler<dim>      &dof_handler,
+                   const IndexSet             &active_set) override;
 
     /**
      * W, and (U1, U2) from S and W into @p solution. The first solve on a
@@ -141,36 +139,35 @@ namespace membranes
      * obstacle_matrix = μ̄ A with the constraints W_a = 0 of @p active_set
      * (DoFs of the locally relevant active vertices) condensed as
      * AffineConstraints condenses them in a cell loop: their rows and
-     * columns eliminated.
+     * columns eliminated, μ̄ ∫|∇φ_a|² on the diagonal.
      */
     void
     make_obstacle_matrix(const DiscreteProblem<dim> &problem,
-                         const DoFHandler<dim>      &dof_handler,
                          const IndexSet             &active_set);
 
-    /** S of this mesh, from A S = F_1 + F_2, to the residual @p tolerance. */
+    /**
+     * S of this mesh, from A S = F_1 + F_2 and the initial guess
+     * @p solution, to the residual @p tolerance.
+     */
     void
     solve_s(const DiscreteProblem<dim> &problem,
+            const BlockVectorType      &solution,
             const double                tolerance,
             ActiveSetStatistics        &statistics);
 
-    /** Hanging node constraints and the boundary values of S, of W. */
-    AffineConstraints<double> s_constraints;
-    AffineConstraints<double> w_constraints;
-
-    /** The lifted loads of S and of W, made once per mesh. */
-    VectorType s_rhs;
-    VectorType w_rhs;
-
-    /** S = μ1 U1 + μ2 U2 and W = U1 − U2 (locally owned). */
+    /**
+     * S = μ1 U1 + μ2 U2 of this mesh (locally owned), solved for once, and
+     * the W = U1 − U2 of the iteration's solve, from which solve() writes
+     * the blocks of the solution (their values at the constrained DoFs are
+     * zero: the solution has its own constraints).
+     */
     VectorType s;
     VectorType w;
     /**
-     * Π and I − Π of the active set of the last assemble() (1 at the
-     * inactive, resp. active, vertices), and the right-hand side of W.
+     * Π and I − Π of the active set of the last set_active_set() (1 at the
+     * inactive, resp. active, vertices).
      */
     DiagonalMatrix<VectorType> inactive_projection, active_projection;
-    VectorType                 rhs;
     /** Whether S has been solved for on this mesh. */
     bool s_solved;
 

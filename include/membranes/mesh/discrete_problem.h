@@ -21,24 +21,6 @@ namespace membranes
   using namespace dealii;
 
   /**
-   * @p hanging_node_constraints (closed) of @p dof_handler and
-   * @p boundary_values, interpolated at its boundary DoFs on all of ∂ω with
-   * @p mapping, into @p constraints (closed): what is constrained on every
-   * iteration of a mesh. A hanging vertex on ∂ω keeps its hanging node
-   * constraint.
-   */
-  template <int dim>
-  void
-  make_mesh_constraints(
-    const Mapping<dim>              &mapping,
-    const DoFHandler<dim>           &dof_handler,
-    const AffineConstraints<double> &hanging_node_constraints,
-    const Function<dim>             &boundary_values,
-    AffineConstraints<double>       &constraints);
-
-
-
-  /**
    * The discrete problem (3.4) on one mesh without its contact condition:
    * the Laplacian and the loads of the two membranes on the scalar P1/Q1
    * space, and the vertices V_h that carry λ_a with the measures d_a of
@@ -104,7 +86,7 @@ namespace membranes
       /**
        * Σ_b |A_ab|, the l1 norm of the row of a in A (condensed with the
        * hanging node constraints and the boundary values): half of it is
-       * the divisor of the projected Jacobi sweeps of ActiveSet.
+       * the divisor of the projected Jacobi sweeps of ActiveSetPrediction.
        */
       double stiffness_row_l1_norm;
     };
@@ -113,27 +95,28 @@ namespace membranes
                     const ProblemData<dim>    &data);
 
     /**
-     * Assemble A, the loads and d_a on the mesh of @p dof_handler, with its
-     * hanging node constraints @p hanging_node_constraints, and take V_h
-     * from the interior vertices of @p dual_mesh.
+     * The constraints of both membranes, A, the loads and d_a on the mesh
+     * of @p dof_handler, whose locally relevant DoFs (those of the owned
+     * and ghost cells) are @p locally_relevant_dofs and whose hanging node
+     * constraints are @p hanging_node_constraints, and V_h from the
+     * interior vertices of @p dual_mesh.
      */
     void
     reinit(const DoFHandler<dim>           &dof_handler,
+           const IndexSet                  &locally_relevant_dofs,
            const AffineConstraints<double> &hanging_node_constraints,
            const DualMesh<dim>             &dual_mesh,
            const MPI_Comm                   mpi_communicator);
 
     /**
-     * @p hanging_node_constraints of @p dof_handler and the boundary values
-     * c1 g + c2 g2 on all of ∂ω, into @p constraints (closed): those of u1
-     * (1, 0), u2 (0, 1) and of their combinations s and w.
+     * The constraints of membrane @p i on every iteration of this mesh:
+     * the hanging node constraints and the boundary values g_1 = g,
+     * g_2 = g2 interpolated at the boundary DoFs (a hanging vertex on ∂ω
+     * keeps its hanging node constraint). Both membranes constrain the
+     * same lines with the same weights; only the inhomogeneities differ.
      */
-    void
-    make_constraints(const DoFHandler<dim>           &dof_handler,
-                     const AffineConstraints<double> &hanging_node_constraints,
-                     const double                     c1,
-                     const double                     c2,
-                     AffineConstraints<double>       &constraints) const;
+    const AffineConstraints<double> &
+    constraints(const unsigned int i) const;
 
     MPI_Comm
     get_mpi_communicator() const;
@@ -214,16 +197,22 @@ namespace membranes
 
   private:
     /**
+     * constraints(0) and constraints(1) of @p dof_handler with its
+     * @p hanging_node_constraints.
+     */
+    void
+    make_constraints(const DoFHandler<dim>           &dof_handler,
+                     const AffineConstraints<double> &hanging_node_constraints);
+
+    /**
      * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
      * condensed by distribute_local_to_global with its constraints.
      */
     void
-    assemble(
-      const DoFHandler<dim>                          &dof_handler,
-      const AffineConstraints<double>                &hanging_node_constraints,
-      const std::array<AffineConstraints<double>, 2> &membrane_constraints,
-      VectorType                                     &dual_cell_measure,
-      VectorType                                     &stiffness_diagonal);
+    assemble(const DoFHandler<dim>           &dof_handler,
+             const AffineConstraints<double> &hanging_node_constraints,
+             VectorType                      &dual_cell_measure,
+             VectorType                      &stiffness_diagonal);
 
     /** V_h and its data, from the vectors that assemble() fills. */
     void
@@ -238,7 +227,8 @@ namespace membranes
     MPI_Comm mpi_communicator;
     IndexSet owned_dofs, relevant_dofs;
 
-    TrilinosWrappers::SparseMatrix matrix;
+    std::array<AffineConstraints<double>, 2> membrane_constraints;
+    TrilinosWrappers::SparseMatrix           matrix;
     std::array<VectorType, 2>      load_vectors;
     std::array<VectorType, 2>      lifted_load_vectors;
     /**

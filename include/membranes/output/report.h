@@ -42,8 +42,6 @@ namespace membranes
   /** The discrete identities of §4.1 measured on the solution. */
   struct IdentityRecord
   {
-    /** Active vertices that are hanging nodes (0: the active set is on V_h). */
-    unsigned int hanging_active_vertices = 0;
     /** min_a (u1h − u2h)(a) and min_a λ_a over V_h. */
     double min_w = 0, min_lambda = 0;
     /** max_a |λ_1a − λ_2a| d_a / F, F the force scale of (4.5) (Prop. 12). */
