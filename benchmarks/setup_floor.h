@@ -88,6 +88,7 @@ namespace setup_floor
   };
 
 
+
   /**
    * One cycle of case M on a new mesh, step by step: the steps of the
    * cycle are in setup_floor_cycle.cc, their timing and the tables in

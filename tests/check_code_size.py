@@ -60,6 +60,7 @@ OTHER_SUFFIXES = (".py", ".sh", ".cmake", ".md")
 
 CONTROL_KEYWORDS = {"if", "for", "while", "switch", "catch", "do", "else",
                     "try", "return", "case", "default"}
+HEX_DIGITS = set("0123456789abcdefABCDEF")
 ACCESS_SPECIFIERS = {"public", "protected", "private"}
 CONTAINER = re.compile(r"^(template\s*<.*>\s*)?(class|struct|union)\b", re.S)
 NAMESPACE = re.compile(r"^(inline\s+)?namespace\b|^extern\s*\"C\"")
@@ -155,7 +156,8 @@ def blank_cxx(text):
             end = text.find(delimiter, open_paren)
             end = n if end < 0 else end + len(delimiter)
         elif c in "\"'":
-            if c == "'" and i > 0 and text[i - 1].isalnum():
+            if c == "'" and 0 < i < n - 1 and text[i - 1] in HEX_DIGITS \
+                    and text[i + 1].isalnum():
                 # A digit separator (1'000), not a character literal.
                 out.append(" ")
                 i += 1
