@@ -12,9 +12,10 @@
  * on matrix-free operators in the way of deal.II's step-37 and step-50 or
  * on assembled level matrices in the way of step-16 and the matrix-based
  * path of step-50, and how it copes with the active set of the contact
- * problem. It does not integrate anything into membranes. The V-cycle on
- * level matrices is in benchmarks/gmg_floor_matrix.cc, the parts that
- * both files use in benchmarks/gmg_floor.h.
+ * problem. It does not integrate anything into membranes. The matrix-free
+ * V-cycle is in benchmarks/gmg_floor_matrix_free.cc, the V-cycle on level
+ * matrices in benchmarks/gmg_floor_matrix.cc, the parts that the three
+ * files share in benchmarks/gmg_floor.h.
  *
  * The mesh is the square (-1,1)² in a parallel::distributed::Triangulation
  * (p4est) with the multigrid hierarchy, one coarse cell refined
@@ -132,13 +133,7 @@
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/matrix_free.h>
 #include <deal.II/matrix_free/operators.h>
-#include <deal.II/multigrid/mg_coarse.h>
 #include <deal.II/multigrid/mg_constrained_dofs.h>
-#include <deal.II/multigrid/mg_matrix.h>
-#include <deal.II/multigrid/mg_smoother.h>
-#include <deal.II/multigrid/mg_tools.h>
-#include <deal.II/multigrid/mg_transfer_matrix_free.h>
-#include <deal.II/multigrid/multigrid.h>
 #include <deal.II/numerics/vector_tools.h>
 #include <fstream>
 #include <functional>
@@ -152,18 +147,6 @@
 
 namespace gmg_floor
 {
-  using VectorType      = LinearAlgebra::distributed::Vector<double>;
-  using LevelVectorType = LinearAlgebra::distributed::Vector<float>;
-  using SystemMatrixType =
-    MatrixFreeOperators::LaplaceOperator<dim, 1, 2, 1, VectorType>;
-  using LevelMatrixType =
-    MatrixFreeOperators::LaplaceOperator<dim, 1, 2, 1, LevelVectorType>;
-  using TransferType = MGTransferMatrixFree<dim, float>;
-  using SmootherType = PreconditionChebyshev<LevelMatrixType, LevelVectorType>;
-  using PreconditionType = PreconditionMG<dim, LevelVectorType, TransferType>;
-
-
-
   IndexSet
   active_level_dofs(const DoFHandler<dim>   &dof_handler,
                     const unsigned int       level,
@@ -184,143 +167,6 @@ namespace gmg_floor
         }
     active.compress();
     return active;
-  }
-
-
-
-  /**
-   * The multigrid preconditioner of step-37: level operators, transfer,
-   * Chebyshev smoother, coarse solver, V-cycle. The active set of
-   * @p shape, if any, is constrained on the levels from @p
-   * first_constrained_level on (variants (b) and (c) of the `w` problem).
-   */
-  class GeometricMultigrid
-  {
-  public:
-    GeometricMultigrid(const DoFHandler<dim> &dof_handler,
-                       const Mapping<dim>    &mapping,
-                       const Shape            shape,
-                       const unsigned int     first_constrained_level,
-                       Recorder              &recorder,
-                       const std::string     &label);
-
-    const PreconditionType &
-    preconditioner() const
-    {
-      return *mg_preconditioner;
-    }
-
-  private:
-    MGConstrainedDoFs              constrained_dofs;
-    MGLevelObject<LevelMatrixType> matrices;
-    MGLevelObject<MatrixFreeOperators::MGInterfaceOperator<LevelMatrixType>>
-                                                          interface_matrices;
-    TransferType                                          transfer;
-    mg::SmootherRelaxation<SmootherType, LevelVectorType> smoother;
-    MGCoarseGridApplySmoother<LevelVectorType>            coarse;
-    mg::Matrix<LevelVectorType>                           matrix_wrapper;
-    mg::Matrix<LevelVectorType>                           interface_wrapper;
-    std::unique_ptr<Multigrid<LevelVectorType>>           multigrid;
-    std::unique_ptr<PreconditionType>                     mg_preconditioner;
-  };
-
-
-
-  GeometricMultigrid::GeometricMultigrid(
-    const DoFHandler<dim> &dof_handler,
-    const Mapping<dim>    &mapping,
-    const Shape            shape,
-    const unsigned int     first_constrained_level,
-    Recorder              &recorder,
-    const std::string     &label)
-  {
-    const unsigned int n_levels =
-      dof_handler.get_triangulation().n_global_levels();
-
-    recorder.timed(label + "levels: constrained DoFs, level MatrixFree", [&]() {
-      constrained_dofs.initialize(dof_handler);
-      constrained_dofs.make_zero_boundary_constraints(dof_handler, {0});
-      matrices.resize(0, n_levels - 1);
-      for (unsigned int level = 0; level < n_levels; ++level)
-        {
-          IndexSet relevant_dofs;
-          DoFTools::extract_locally_relevant_level_dofs(dof_handler,
-                                                        level,
-                                                        relevant_dofs);
-          AffineConstraints<double> level_constraints(relevant_dofs);
-          level_constraints.add_lines(
-            constrained_dofs.get_boundary_indices(level));
-
-          if (shape != Shape::none && level >= first_constrained_level)
-            {
-              // The level DoFs at the vertices of the active set, as
-              // homogeneous constraints of the level operator and as user
-              // constraints of the transfer.
-              AffineConstraints<double> active(relevant_dofs);
-              active.add_lines(
-                active_level_dofs(dof_handler, level, shape, constrained_dofs));
-              active.close();
-              level_constraints.merge(
-                active,
-                AffineConstraints<
-                  double>::MergeConflictBehavior::right_object_wins);
-              constrained_dofs.add_user_constraints(level, active);
-            }
-          level_constraints.close();
-
-          typename MatrixFree<dim, float>::AdditionalData data;
-          data.tasks_parallel_scheme =
-            MatrixFree<dim, float>::AdditionalData::none;
-          data.mapping_update_flags = update_gradients | update_JxW_values;
-          data.mg_level             = level;
-          auto level_storage = std::make_shared<MatrixFree<dim, float>>();
-          level_storage->reinit(
-            mapping, dof_handler, level_constraints, QGauss<1>(2), data);
-          matrices[level].initialize(level_storage, constrained_dofs, level);
-        }
-    });
-
-    recorder.timed(label + "transfer", [&]() {
-      transfer.initialize_constraints(constrained_dofs);
-      transfer.build(dof_handler);
-    });
-
-    recorder.timed(label + "smoother: diagonals, eigenvalue estimates", [&]() {
-      MGLevelObject<SmootherType::AdditionalData> smoother_data(0,
-                                                                n_levels - 1);
-      for (unsigned int level = 0; level < n_levels; ++level)
-        {
-          if (level > 0)
-            {
-              smoother_data[level].smoothing_range     = 15.;
-              smoother_data[level].degree              = 5;
-              smoother_data[level].eig_cg_n_iterations = 10;
-            }
-          else
-            {
-              smoother_data[0].smoothing_range = 1e-3;
-              smoother_data[0].degree          = numbers::invalid_unsigned_int;
-              smoother_data[0].eig_cg_n_iterations = matrices[0].m();
-            }
-          matrices[level].compute_diagonal();
-          smoother_data[level].preconditioner =
-            matrices[level].get_matrix_diagonal_inverse();
-        }
-      smoother.initialize(matrices, smoother_data);
-      coarse.initialize(smoother);
-
-      interface_matrices.resize(0, n_levels - 1);
-      for (unsigned int level = 0; level < n_levels; ++level)
-        interface_matrices[level].initialize(matrices[level]);
-      matrix_wrapper.initialize(matrices);
-      interface_wrapper.initialize(interface_matrices);
-
-      multigrid = std::make_unique<Multigrid<LevelVectorType>>(
-        matrix_wrapper, coarse, transfer, smoother, smoother);
-      multigrid->set_edge_matrices(interface_wrapper, interface_wrapper);
-      mg_preconditioner =
-        std::make_unique<PreconditionType>(dof_handler, *multigrid, transfer);
-    });
   }
 
 

@@ -1,9 +1,11 @@
 /**
- * The parts of benchmarks/gmg_floor.cc that its matrix-based multigrid,
- * benchmarks/gmg_floor_matrix.cc, shares: the active sets, the timed
- * steps, the level DoFs of an active set, the cell matrix of the
- * Laplacian, and the V-cycle on assembled level matrices. The head
- * comment of gmg_floor.cc says what the program measures.
+ * The parts of benchmarks/gmg_floor.cc that its two multigrid
+ * preconditioners share: the active sets, the timed steps, the level DoFs
+ * of an active set, the cell matrix of the Laplacian, the settings of the
+ * Chebyshev smoother, and the two V-cycles, matrix-free
+ * (benchmarks/gmg_floor_matrix_free.cc) and on assembled level matrices
+ * (benchmarks/gmg_floor_matrix.cc). The head comment of gmg_floor.cc says
+ * what the program measures.
  */
 
 #ifndef membranes_benchmarks_gmg_floor_h
@@ -19,15 +21,18 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/la_parallel_vector.h>
 #include <deal.II/lac/precondition.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
+#include <deal.II/matrix_free/operators.h>
 #include <deal.II/multigrid/mg_coarse.h>
 #include <deal.II/multigrid/mg_constrained_dofs.h>
 #include <deal.II/multigrid/mg_matrix.h>
 #include <deal.II/multigrid/mg_smoother.h>
 #include <deal.II/multigrid/mg_transfer.h>
+#include <deal.II/multigrid/mg_transfer_matrix_free.h>
 #include <deal.II/multigrid/multigrid.h>
 #include <functional>
 #include <iomanip>
@@ -205,6 +210,92 @@ namespace gmg_floor
 
 
 
+  /**
+   * The settings of the Chebyshev smoother on @p level: degree @p degree,
+   * smoothing range 15 and 10 CG iterations for the eigenvalue estimate;
+   * on the coarse level, of @p n_coarse_dofs DoFs, Chebyshev iterated to
+   * accuracy (the coarse solver).
+   */
+  template <typename AdditionalData>
+  AdditionalData
+  chebyshev_settings(const unsigned int level,
+                     const unsigned int degree,
+                     const unsigned int n_coarse_dofs)
+  {
+    AdditionalData data;
+    if (level > 0)
+      {
+        data.smoothing_range     = 15.;
+        data.degree              = degree;
+        data.eig_cg_n_iterations = 10;
+      }
+    else
+      {
+        data.smoothing_range     = 1e-3;
+        data.degree              = numbers::invalid_unsigned_int;
+        data.eig_cg_n_iterations = n_coarse_dofs;
+      }
+    return data;
+  }
+
+
+
+  using VectorType      = LinearAlgebra::distributed::Vector<double>;
+  using LevelVectorType = LinearAlgebra::distributed::Vector<float>;
+  using SystemMatrixType =
+    MatrixFreeOperators::LaplaceOperator<dim, 1, 2, 1, VectorType>;
+  using LevelMatrixType =
+    MatrixFreeOperators::LaplaceOperator<dim, 1, 2, 1, LevelVectorType>;
+  using TransferType = MGTransferMatrixFree<dim, float>;
+  using SmootherType = PreconditionChebyshev<LevelMatrixType, LevelVectorType>;
+  using PreconditionType = PreconditionMG<dim, LevelVectorType, TransferType>;
+
+  /**
+   * The multigrid preconditioner of step-37: level operators, transfer,
+   * Chebyshev smoother, coarse solver, V-cycle. The active set of
+   * @p shape, if any, is constrained on the levels from @p
+   * first_constrained_level on (variants (b) and (c) of the `w` problem).
+   */
+  class GeometricMultigrid
+  {
+  public:
+    GeometricMultigrid(const DoFHandler<dim> &dof_handler,
+                       const Mapping<dim>    &mapping,
+                       const Shape            shape,
+                       const unsigned int     first_constrained_level,
+                       Recorder              &recorder,
+                       const std::string     &label);
+
+    const PreconditionType &
+    preconditioner() const
+    {
+      return *mg_preconditioner;
+    }
+
+  private:
+    void
+    setup_level_operators(const DoFHandler<dim> &dof_handler,
+                          const Mapping<dim>    &mapping,
+                          const Shape            shape,
+                          const unsigned int     first_constrained_level);
+    void
+    setup_smoother_and_cycle(const DoFHandler<dim> &dof_handler);
+
+    MGConstrainedDoFs              constrained_dofs;
+    MGLevelObject<LevelMatrixType> matrices;
+    MGLevelObject<MatrixFreeOperators::MGInterfaceOperator<LevelMatrixType>>
+                                                          interface_matrices;
+    TransferType                                          transfer;
+    mg::SmootherRelaxation<SmootherType, LevelVectorType> smoother;
+    MGCoarseGridApplySmoother<LevelVectorType>            coarse;
+    mg::Matrix<LevelVectorType>                           matrix_wrapper;
+    mg::Matrix<LevelVectorType>                           interface_wrapper;
+    std::unique_ptr<Multigrid<LevelVectorType>>           multigrid;
+    std::unique_ptr<PreconditionType>                     mg_preconditioner;
+  };
+
+
+
   /** The degree of the Chebyshev smoother on level matrices by default. */
   constexpr unsigned int default_matrix_degree = 4;
 
@@ -266,6 +357,18 @@ namespace gmg_floor
     }
 
   private:
+    void
+    setup_level_matrices(const DoFHandler<dim> &dof_handler,
+                         const Shape            shape,
+                         std::vector<IndexSet> &relevant_dofs);
+    void
+    assemble_level_matrices(const DoFHandler<dim>       &dof_handler,
+                            const Mapping<dim>          &mapping,
+                            const std::vector<IndexSet> &relevant_dofs);
+    void
+    setup_smoother_and_cycle(const DoFHandler<dim> &dof_handler,
+                             const unsigned int     degree);
+
     MGConstrainedDoFs               constrained_dofs;
     MGLevelObject<SparseMatrixType> matrices;
     MGLevelObject<SparseMatrixType> interface_matrices;

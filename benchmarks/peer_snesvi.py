@@ -160,124 +160,167 @@ CSV_COLUMNS = ["level", "dofs", "snes_iterations", "active_vertices",
                "err_u2_H1", "err_u1_L2", "err_u2_L2"]
 
 
+def interpolate_coarse(coarse, V):
+    """The coarse P1 function evaluated at the dofs (vertices) of
+    the finer space V: exactly the coarse function, as the fine mesh
+    refines the coarse one."""
+    import numpy as np
+    from dolfinx import fem, geometry
+
+    coarse_mesh = coarse.function_space.mesh
+    tree = geometry.BoundingBoxTree(coarse_mesh, coarse_mesh.topology.dim)
+
+    def values(x):
+        points = np.ascontiguousarray(x.T)
+        cells = geometry.compute_colliding_cells(
+            coarse_mesh, geometry.compute_collisions(tree, points), points)
+        return coarse.eval(points, cells.array[cells.offsets[:-1]]).T
+
+    u = fem.Function(V)
+    u.interpolate(values)
+    return u
+
+
+def discrete_problem(comm, level, scene, mu1, mu2):
+    """The mesh of the level (n = 2^(level+3)), the two-component P1 space V
+    of (u1, w), the exact solution, and the gradient of the energy in
+    (u1, w), u2 = u1 - w: F(x) = A x - b with A and b assembled, the
+    boundary values (u1 = g, w = g - g2) lifted. Returns V, A, b, the
+    boundary conditions and the exact u1, u2 (UFL)."""
+    import numpy as np
+    import ufl
+    from dolfinx import fem, mesh
+    from dolfinx.fem import petsc as fem_petsc
+
+    n = 2 ** (level + 3)
+    domain = mesh.create_rectangle(
+        comm, [np.array([-1.0, -1.0]), np.array([1.0, 1.0])], [n, n],
+        mesh.CellType.triangle, diagonal=mesh.DiagonalType.right)
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 1), dim=2)
+
+    # Exact solution and data.
+    x = ufl.SpatialCoordinate(domain)
+    u1_exact, u2_exact, f1, f2, boundary = SCENES[scene](x, mu1, mu2)
+
+    # The gradient of the energy in (u1, w), u2 = u1 - w, is
+    # F(x) = A x - b with these forms.
+    du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    du1, du2 = du[0], du[0] - du[1]
+    v1, v2 = v[0], v[0] - v[1]
+    a = fem.form((mu1 * ufl.inner(ufl.grad(du1), ufl.grad(v1))
+                  + mu2 * ufl.inner(ufl.grad(du2), ufl.grad(v2))) * ufl.dx)
+    load = fem.form((f1 * v1 + f2 * v2)
+                    * ufl.dx(metadata={"quadrature_degree": 5}))
+
+    # u1 = g, w = g - g2 on the boundary.
+    boundary_values = fem.Function(V)
+    boundary_values.interpolate(lambda p: np.array(boundary(np, p)))
+    domain.topology.create_connectivity(1, 2)
+    boundary_dofs = fem.locate_dofs_topological(
+        V, 1, mesh.exterior_facet_indices(domain.topology))
+    bcs = [fem.dirichletbc(boundary_values, boundary_dofs)]
+
+    A = fem_petsc.assemble_matrix(a, bcs)
+    A.assemble()
+    b = fem_petsc.assemble_vector(load)
+    fem_petsc.apply_lifting(b, [a], [bcs])
+    fem_petsc.set_bc(b, bcs)
+    return V, A, b, bcs, u1_exact, u2_exact
+
+
+def initial_guess(V, bcs, previous):
+    """The previous level's solution (or zero on level 0) with
+    the boundary values of this level, w projected onto w >= 0."""
+    import numpy as np
+    from dolfinx import fem
+    from dolfinx.fem import petsc as fem_petsc
+
+    u = fem.Function(V)
+    if previous is not None:
+        u.x.array[:] = interpolate_coarse(previous, V).x.array
+    fem_petsc.set_bc(u.vector, bcs)
+    u.x.array[1::2] = np.maximum(u.x.array[1::2], 0.0)
+    return u
+
+
+def solve_variational_inequality(comm, level, A, b, u):
+    """A x = b on the inactive set, w >= 0, by SNES vinewtonrsls with MUMPS
+    LU from the initial guess u, which holds the solution afterwards.
+    Returns the SNES (Newton) iterations; exits if SNES did not converge."""
+    from petsc4py import PETSc
+
+    lower = u.vector.duplicate()
+    lower.array[0::2] = -PETSc.INFINITY
+    lower.array[1::2] = 0.0
+    upper = u.vector.duplicate()
+    upper.set(PETSc.INFINITY)
+
+    def residual(snes, x, r):
+        A.mult(x, r)
+        r.axpy(-1.0, b)
+
+    def jacobian(snes, x, J, P):
+        """Nothing to do: the Jacobian is A, assembled above."""
+
+    snes = PETSc.SNES().create(comm)
+    snes.setType("vinewtonrsls")
+    snes.setFunction(residual, b.duplicate())
+    snes.setJacobian(jacobian, A)
+    snes.setVariableBounds(lower, upper)
+    snes.setTolerances(rtol=1e-10, atol=1e-12 * b.norm())
+    ksp = snes.getKSP()
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    snes.setFromOptions()
+    snes.solve(None, u.vector)
+    if snes.getConvergedReason() <= 0:
+        sys.exit(f"peer_snesvi.py: error: SNES did not converge on level "
+                 f"{level} (reason {snes.getConvergedReason()})")
+    iterations = snes.getIterationNumber()
+    snes.destroy()
+    return iterations
+
+
+def error_norms(u, u1_exact, u2_exact):
+    """||u_i - u_ih||_H1 (the full norms, as membranes reports them (3.5))
+    and ||u_i - u_ih||_L2, by quadrature of degree 8."""
+    import ufl
+    from dolfinx import fem
+
+    dx_error = ufl.dx(metadata={"quadrature_degree": 8})
+
+    def norm(square):
+        return math.sqrt(fem.assemble_scalar(fem.form(square * dx_error)))
+
+    e1 = u[0] - u1_exact
+    e2 = u[0] - u[1] - u2_exact
+    return [norm(ufl.inner(ufl.grad(e1), ufl.grad(e1)) + e1 * e1),
+            norm(ufl.inner(ufl.grad(e2), ufl.grad(e2)) + e2 * e2),
+            norm(e1 * e1), norm(e2 * e2)]
+
+
 def solve(scene, levels, mu1, mu2, output, petsc_options):
     """Solve on levels 0 .. levels-1, print progress, write the CSV file."""
     # Imported here, so that the table mode needs the standard library only.
     import numpy as np
-    import ufl
     from mpi4py import MPI
     from petsc4py import PETSc
-    from dolfinx import fem, geometry, mesh
-    from dolfinx.fem import petsc as fem_petsc
 
     PETSc.Options().insertString(" ".join(petsc_options))
     comm = MPI.COMM_SELF
-
-    def transfer(coarse, V):
-        """The coarse P1 function evaluated at the dofs (vertices) of V."""
-        coarse_mesh = coarse.function_space.mesh
-        tree = geometry.BoundingBoxTree(coarse_mesh, coarse_mesh.topology.dim)
-
-        def values(x):
-            points = np.ascontiguousarray(x.T)
-            cells = geometry.compute_colliding_cells(
-                coarse_mesh, geometry.compute_collisions(tree, points), points)
-            return coarse.eval(points, cells.array[cells.offsets[:-1]]).T
-
-        u = fem.Function(V)
-        u.interpolate(values)
-        return u
 
     rows = []
     cumulative = 0.0
     previous = None
     for level in range(levels):
         start = time.perf_counter()
-        n = 2 ** (level + 3)
-        domain = mesh.create_rectangle(
-            comm, [np.array([-1.0, -1.0]), np.array([1.0, 1.0])], [n, n],
-            mesh.CellType.triangle, diagonal=mesh.DiagonalType.right)
-        V = fem.VectorFunctionSpace(domain, ("Lagrange", 1), dim=2)
-
-        # Exact solution and data.
-        x = ufl.SpatialCoordinate(domain)
-        u1_exact, u2_exact, f1, f2, boundary = SCENES[scene](x, mu1, mu2)
-
-        # The gradient of the energy in (u1, w), u2 = u1 - w, is
-        # F(x) = A x - b with these forms.
-        du, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        du1, du2 = du[0], du[0] - du[1]
-        v1, v2 = v[0], v[0] - v[1]
-        a = fem.form((mu1 * ufl.inner(ufl.grad(du1), ufl.grad(v1))
-                      + mu2 * ufl.inner(ufl.grad(du2), ufl.grad(v2))) * ufl.dx)
-        load = fem.form((f1 * v1 + f2 * v2)
-                        * ufl.dx(metadata={"quadrature_degree": 5}))
-
-        # u1 = g, w = g - g2 on the boundary.
-        boundary_values = fem.Function(V)
-        boundary_values.interpolate(lambda p: np.array(boundary(np, p)))
-        domain.topology.create_connectivity(1, 2)
-        boundary_dofs = fem.locate_dofs_topological(
-            V, 1, mesh.exterior_facet_indices(domain.topology))
-        bcs = [fem.dirichletbc(boundary_values, boundary_dofs)]
-
-        A = fem_petsc.assemble_matrix(a, bcs)
-        A.assemble()
-        b = fem_petsc.assemble_vector(load)
-        fem_petsc.apply_lifting(b, [a], [bcs])
-        fem_petsc.set_bc(b, bcs)
-
-        # Initial guess: the previous level's solution, or zero; boundary
-        # values; w projected onto w >= 0.
-        u = fem.Function(V)
-        if previous is not None:
-            u.x.array[:] = transfer(previous, V).x.array
-        fem_petsc.set_bc(u.vector, bcs)
-        u.x.array[1::2] = np.maximum(u.x.array[1::2], 0.0)
-
-        lower = u.vector.duplicate()
-        lower.array[0::2] = -PETSc.INFINITY
-        lower.array[1::2] = 0.0
-        upper = u.vector.duplicate()
-        upper.set(PETSc.INFINITY)
-
-        def residual(snes, x, r):
-            A.mult(x, r)
-            r.axpy(-1.0, b)
-
-        def jacobian(snes, x, J, P):
-            """Nothing to do: the Jacobian is A, assembled above."""
-
-        snes = PETSc.SNES().create(comm)
-        snes.setType("vinewtonrsls")
-        snes.setFunction(residual, b.duplicate())
-        snes.setJacobian(jacobian, A)
-        snes.setVariableBounds(lower, upper)
-        snes.setTolerances(rtol=1e-10, atol=1e-12 * b.norm())
-        ksp = snes.getKSP()
-        ksp.setType("preonly")
-        ksp.getPC().setType("lu")
-        ksp.getPC().setFactorSolverType("mumps")
-        snes.setFromOptions()
-        snes.solve(None, u.vector)
-        if snes.getConvergedReason() <= 0:
-            sys.exit(f"peer_snesvi.py: error: SNES did not converge on level "
-                     f"{level} (reason {snes.getConvergedReason()})")
-        iterations = snes.getIterationNumber()
+        V, A, b, bcs, u1_exact, u2_exact = discrete_problem(
+            comm, level, scene, mu1, mu2)
+        u = initial_guess(V, bcs, previous)
+        iterations = solve_variational_inequality(comm, level, A, b, u)
         active = np.count_nonzero(u.x.array[1::2] == 0.0)
-
-        dx_error = ufl.dx(metadata={"quadrature_degree": 8})
-
-        def norm(square):
-            return math.sqrt(fem.assemble_scalar(fem.form(square * dx_error)))
-
-        e1 = u[0] - u1_exact
-        e2 = u[0] - u[1] - u2_exact
-        # The full H1 norms, as membranes reports them (3.5), and the L2 norms.
-        errors = [norm(ufl.inner(ufl.grad(e1), ufl.grad(e1)) + e1 * e1),
-                  norm(ufl.inner(ufl.grad(e2), ufl.grad(e2)) + e2 * e2),
-                  norm(e1 * e1), norm(e2 * e2)]
-        snes.destroy()
+        errors = error_norms(u, u1_exact, u2_exact)
         previous = u
 
         seconds = time.perf_counter() - start

@@ -12,6 +12,7 @@
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
 #include <iostream>
+#include <map>
 #include <membranes/scene/compiled_function.h>
 #include <muParser.h>
 
@@ -108,19 +109,27 @@ namespace
       }
 #endif
   }
-} // namespace
 
-int
-main(int argc, char **argv)
-{
-  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
-  // The constants of the scene, and those muparser defines (_pi, _e).
-  std::map<std::string, double> constants{{"pi", numbers::PI},
-                                          {"R", 0.5},
-                                          {"mu1", 2.}};
-  const mu::Parser              muparser;
-  for (const auto &[name, value] : muparser.GetConst())
-    constants[name] = value;
+
+  /**
+   * The constants of the scene, and those muparser defines (_pi, _e), for
+   * the compiled expressions.
+   */
+  std::map<std::string, double>
+  scene_constants()
+  {
+    std::map<std::string, double> constants{{"pi", numbers::PI},
+                                            {"R", 0.5},
+                                            {"mu1", 2.}};
+    const mu::Parser              muparser;
+    for (const auto &[name, value] : muparser.GetConst())
+      constants[name] = value;
+    return constants;
+  }
+
+
+
+  /** Every operator and function of the grammar, and the constants. */
   const std::vector<std::string> expressions{
     "1 + 2*x - y/3 + -x*-y",
     "-x^2 + 2^-y^2 + (2+x)^3^0.5 - (x+2)^-3 + (1+y)^2.5",
@@ -137,7 +146,62 @@ main(int argc, char **argv)
     "-mu1*(1 - x^2 - y^2)^3 * (x^2 + y^2 > R^2 ? 1 : 0) + 1e-3*.5/2.",
     "cos(pi*x/2)*cos(pi*y/2) + ((x-0.2)^2 + (y+0.1)^2 - R^2)^3",
     "sin(x)*cos(y) + exp(x*y) + log(2 + x) + pow(2 + x, y)"};
-  const std::vector<Point<2>> points{Point<2>(0.3, -0.7),
+
+
+
+  /**
+   * Expression @p i of @p compiled at @p p: its value against deal.II's
+   * FunctionParser @p parser to 1e-13, its gradient against central
+   * differences of step 1e-6 to 1e-6, its Laplacian against second
+   * differences of step 1e-3 to 1e-4 of the size of the second derivatives.
+   */
+  void
+  check_at_point(const membranes::CompiledFunctions &compiled,
+                 const unsigned int                  i,
+                 const FunctionParser<2>            &parser,
+                 const Point<2>                     &p)
+  {
+    const double value = compiled.value(i)(&p[0]);
+    compare("value",
+            expressions[i],
+            p,
+            value,
+            parser.value(p),
+            1e-13 * std::max(1., std::abs(value)));
+    double gradient[2];
+    compiled.gradient(i)(&p[0], gradient);
+    double     laplacian = 0, scale = 1;
+    const auto f = [&](const Point<2> &q) { return compiled.value(i)(&q[0]); };
+    for (unsigned int d = 0; d < 2; ++d)
+      {
+        Tensor<1, 2> e;
+        e[d]           = 1;
+        const double h = 1e-6, H = 1e-3;
+        compare("derivative " + std::to_string(d),
+                expressions[i],
+                p,
+                gradient[d],
+                (f(p + h * e) - f(p - h * e)) / (2 * h),
+                1e-6 * std::max(1., std::abs(gradient[d])));
+        const double second =
+          (f(p + H * e) - 2 * f(p) + f(p - H * e)) / (H * H);
+        laplacian += second;
+        scale += std::abs(second);
+      }
+    compare("Laplacian",
+            expressions[i],
+            p,
+            compiled.laplacian(i)(&p[0]),
+            laplacian,
+            1e-4 * scale);
+  }
+} // namespace
+
+int
+main(int argc, char **argv)
+{
+  Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const std::vector<Point<2>>      points{Point<2>(0.3, -0.7),
                                      Point<2>(-0.45, 0.61),
                                      Point<2>(0.77, 0.12)};
 
@@ -159,7 +223,7 @@ main(int argc, char **argv)
     }
   const membranes::CompiledFunctions compiled(requests,
                                               {"x", "y"},
-                                              constants,
+                                              scene_constants(),
                                               groups);
 
   for (unsigned int i = 0; i < expressions.size(); ++i)
@@ -169,43 +233,7 @@ main(int argc, char **argv)
                         expressions[i],
                         {{"pi", numbers::PI}, {"R", 0.5}, {"mu1", 2.}});
       for (const Point<2> &p : points)
-        {
-          const double value = compiled.value(i)(&p[0]);
-          compare("value",
-                  expressions[i],
-                  p,
-                  value,
-                  parser.value(p),
-                  1e-13 * std::max(1., std::abs(value)));
-          double gradient[2];
-          compiled.gradient(i)(&p[0], gradient);
-          double     laplacian = 0, scale = 1;
-          const auto f = [&](const Point<2> &q) {
-            return compiled.value(i)(&q[0]);
-          };
-          for (unsigned int d = 0; d < 2; ++d)
-            {
-              Tensor<1, 2> e;
-              e[d]           = 1;
-              const double h = 1e-6, H = 1e-3;
-              compare("derivative " + std::to_string(d),
-                      expressions[i],
-                      p,
-                      gradient[d],
-                      (f(p + h * e) - f(p - h * e)) / (2 * h),
-                      1e-6 * std::max(1., std::abs(gradient[d])));
-              const double second =
-                (f(p + H * e) - 2 * f(p) + f(p - H * e)) / (H * H);
-              laplacian += second;
-              scale += std::abs(second);
-            }
-          compare("Laplacian",
-                  expressions[i],
-                  p,
-                  compiled.laplacian(i)(&p[0]),
-                  laplacian,
-                  1e-4 * scale);
-        }
+        check_at_point(compiled, i, parser, p);
     }
 
   check_groups(compiled, groups, expressions);

@@ -99,6 +99,7 @@
  */
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/mpi.h>
@@ -522,6 +523,133 @@ namespace
 
 
 
+  /**
+   * The pieces K ∩ D_a of the dual cell of the vertex at @p a, read off
+   * the sub-triangles of S_h that FluxReconstruction::patches() gives for
+   * the output, independently of the library's own sums: meas(K ∩ D_a)
+   * for each cell K, meas(D_a) and ∫_{D_a} div t_ih, i = 1, 2.
+   */
+  struct DualCellPieces
+  {
+    unsigned int          sub_triangles_per_cell;
+    std::vector<double>   cell_measure;
+    double                measure    = 0;
+    std::array<double, 2> divergence = {{0, 0}};
+  };
+
+  DualCellPieces
+  dual_cell_pieces(TinyProblem &problem, const Point<dim> &a)
+  {
+    problem.flux_reconstruction.reconstruct(problem.dof_handler,
+                                            problem.ghosted_solution);
+    unsigned int a_vertex = numbers::invalid_unsigned_int;
+    for (unsigned int v = 0; v < problem.triangulation->n_vertices(); ++v)
+      if (problem.triangulation->get_vertices()[v].distance(a) < 1e-12)
+        a_vertex = v;
+    const auto patches =
+      problem.flux_reconstruction.patches(problem.dof_handler,
+                                          problem.dual_mesh,
+                                          problem.lambda_h);
+    const auto names  = FluxReconstruction<dim>::data_names();
+    const auto column = [&](const std::string &name) {
+      return std::find(names.begin(), names.end(), name) - names.begin();
+    };
+    DualCellPieces pieces;
+    pieces.sub_triangles_per_cell =
+      patches.size() / problem.triangulation->n_active_cells();
+    pieces.cell_measure.resize(problem.triangulation->n_active_cells());
+    for (unsigned int p = 0; p < patches.size(); ++p)
+      {
+        const auto &patch = patches[p];
+        if (std::lround(patch.data(column("dual_vertex"), 0)) != a_vertex)
+          continue;
+        const Tensor<1, dim> e1   = patch.vertices[1] - patch.vertices[0];
+        const Tensor<1, dim> e2   = patch.vertices[2] - patch.vertices[0];
+        const double         area = std::abs(e1[0] * e2[1] - e1[1] * e2[0]) / 2;
+        pieces.cell_measure[p / pieces.sub_triangles_per_cell] += area;
+        pieces.measure += area;
+        pieces.divergence[0] += patch.data(column("div_t1"), 0) * area;
+        pieces.divergence[1] += patch.data(column("div_t2"), 0) * area;
+      }
+    return pieces;
+  }
+
+
+
+  /**
+   * Mesh 3, the dual cell D_a of its vertex k (at the centre), from the
+   * sub-triangles of S_h: (4.17), (4.18) and step 4 of Lemma 17.
+   */
+  void
+  check_four_triangles_dual_cell(TinyProblem &problem, const unsigned int k)
+  {
+    const DualCellPieces pieces =
+      dual_cell_pieces(problem, Point<dim>(0.5, 0.5));
+    check_true("P1 4 triangles: S_h has two sub-triangles per vertex of K",
+               pieces.sub_triangles_per_cell == 6);
+    // (4.17): meas(K ∩ D_a) = meas(K)/3 on every K: a misplaced barycentre
+    // or midpoint in the dual mesh.
+    for (unsigned int c = 0; c < pieces.cell_measure.size(); ++c)
+      check("P1 4 triangles: (4.17) meas(K" + std::to_string(c) +
+              " cap D_a) = meas(K)/3",
+            pieces.cell_measure[c],
+            1. / 12.);
+    // (4.17) summed: meas(D_a) = d_a = 1/3.
+    check("P1 4 triangles: (4.17) meas(D_a) = d_a", pieces.measure, 1. / 3.);
+    check("P1 4 triangles: (4.17) meas(D_a) = library's d_a",
+          pieces.measure,
+          problem.discrete_problem.vertices()[k].dual_cell_measure);
+    // (4.18): the fluxes (4.13) through ∂D_a, i.e. t_ih · n = −μ_i ∂_n u_ih.
+    for (unsigned int i = 0; i < 2; ++i)
+      check("P1 4 triangles: (4.18) int_{D_a} div t_" + std::to_string(i + 1) +
+              "h = mu_" + std::to_string(i + 1) + " int grad u_ih . grad phi_a",
+            pieces.divergence[i],
+            -(i + 1.) / 9.,
+            (i + 1.) / 9.,
+            float_tolerance);
+    // Lemma 17, step 4: λ_a meas(D_a) = ∫_{D_a} (div t_1h − f_1h) = 5/9.
+    check("P1 4 triangles: Lemma 17 lambda_a meas(D_a) = int_{D_a} (div t_1h "
+          "- f_1h)",
+          pieces.divergence[0] + 2. * pieces.measure,
+          5. / 9.,
+          5. / 9.,
+          float_tolerance);
+    check("P1 4 triangles: lambda_a meas(D_a) from the action",
+          problem.action.lambda(k) * pieces.measure,
+          5. / 9.);
+  }
+
+
+
+  /**
+   * The library's own report of the identities of mesh 3, in double
+   * precision: a fault in its sums over the pieces K ∩ D_a (or in t_ih on
+   * a half-edge inside D_a that the float checks of the pieces would miss).
+   */
+  void
+  check_four_triangles_identities(const TinyProblem &problem)
+  {
+    const auto identities =
+      problem.flux_reconstruction.identities(problem.dof_handler,
+                                             problem.constraints,
+                                             problem.discrete_problem,
+                                             problem.action);
+    check("P1 4 triangles: identities().measure_defect",
+          identities.measure_defect,
+          0,
+          1.);
+    check("P1 4 triangles: identities().conservation_defect",
+          identities.conservation_defect,
+          0,
+          1.);
+    check("P1 4 triangles: identities().balance_defect",
+          identities.balance_defect,
+          0,
+          1.);
+  }
+
+
+
   /** Mesh 3: four triangles around the centre of the unit square. */
   void
   four_triangles()
@@ -567,92 +695,8 @@ namespace
             problem.action.stiffness_term(problem.discrete_problem, i, k),
             -(i + 1.) / 9.);
 
-    // The dual cell D_a and div t_ih, from the sub-triangles of S_h.
-    problem.flux_reconstruction.reconstruct(problem.dof_handler,
-                                            problem.ghosted_solution);
-    unsigned int a_vertex = numbers::invalid_unsigned_int;
-    for (unsigned int v = 0; v < problem.triangulation->n_vertices(); ++v)
-      if (problem.triangulation->get_vertices()[v].distance(
-            Point<dim>(0.5, 0.5)) < 1e-12)
-        a_vertex = v;
-    const auto patches =
-      problem.flux_reconstruction.patches(problem.dof_handler,
-                                          problem.dual_mesh,
-                                          problem.lambda_h);
-    const auto names  = FluxReconstruction<dim>::data_names();
-    const auto column = [&](const std::string &name) {
-      return std::find(names.begin(), names.end(), name) - names.begin();
-    };
-    const unsigned int sub_triangles_per_cell =
-      patches.size() / problem.triangulation->n_active_cells();
-    std::vector<double> piece_measure(problem.triangulation->n_active_cells());
-    double              measure = 0, divergence[2] = {0, 0};
-    for (unsigned int p = 0; p < patches.size(); ++p)
-      {
-        const auto &patch = patches[p];
-        if (std::lround(patch.data(column("dual_vertex"), 0)) != a_vertex)
-          continue;
-        const Tensor<1, dim> e1   = patch.vertices[1] - patch.vertices[0];
-        const Tensor<1, dim> e2   = patch.vertices[2] - patch.vertices[0];
-        const double         area = std::abs(e1[0] * e2[1] - e1[1] * e2[0]) / 2;
-        piece_measure[p / sub_triangles_per_cell] += area;
-        measure += area;
-        divergence[0] += patch.data(column("div_t1"), 0) * area;
-        divergence[1] += patch.data(column("div_t2"), 0) * area;
-      }
-    check_true("P1 4 triangles: S_h has two sub-triangles per vertex of K",
-               sub_triangles_per_cell == 6);
-    // (4.17): meas(K ∩ D_a) = meas(K)/3 on every K: a misplaced barycentre
-    // or midpoint in the dual mesh.
-    for (unsigned int c = 0; c < piece_measure.size(); ++c)
-      check("P1 4 triangles: (4.17) meas(K" + std::to_string(c) +
-              " cap D_a) = meas(K)/3",
-            piece_measure[c],
-            1. / 12.);
-    // (4.17) summed: meas(D_a) = d_a = 1/3.
-    check("P1 4 triangles: (4.17) meas(D_a) = d_a", measure, 1. / 3.);
-    check("P1 4 triangles: (4.17) meas(D_a) = library's d_a",
-          measure,
-          a.dual_cell_measure);
-    // (4.18): the fluxes (4.13) through ∂D_a, i.e. t_ih · n = −μ_i ∂_n u_ih.
-    for (unsigned int i = 0; i < 2; ++i)
-      check("P1 4 triangles: (4.18) int_{D_a} div t_" + std::to_string(i + 1) +
-              "h = mu_" + std::to_string(i + 1) + " int grad u_ih . grad phi_a",
-            divergence[i],
-            -(i + 1.) / 9.,
-            (i + 1.) / 9.,
-            float_tolerance);
-    // Lemma 17, step 4: λ_a meas(D_a) = ∫_{D_a} (div t_1h − f_1h) = 5/9.
-    check("P1 4 triangles: Lemma 17 lambda_a meas(D_a) = int_{D_a} (div t_1h "
-          "- f_1h)",
-          divergence[0] + 2. * measure,
-          5. / 9.,
-          5. / 9.,
-          float_tolerance);
-    check("P1 4 triangles: lambda_a meas(D_a) from the action",
-          problem.action.lambda(k) * measure,
-          5. / 9.);
-
-    // The library's own report of the same identities, in double precision:
-    // a fault in its sums over the pieces K ∩ D_a (or in t_ih on a half-edge
-    // inside D_a that the float checks above would miss).
-    const auto identities =
-      problem.flux_reconstruction.identities(problem.dof_handler,
-                                             problem.constraints,
-                                             problem.discrete_problem,
-                                             problem.action);
-    check("P1 4 triangles: identities().measure_defect",
-          identities.measure_defect,
-          0,
-          1.);
-    check("P1 4 triangles: identities().conservation_defect",
-          identities.conservation_defect,
-          0,
-          1.);
-    check("P1 4 triangles: identities().balance_defect",
-          identities.balance_defect,
-          0,
-          1.);
+    check_four_triangles_dual_cell(problem, k);
+    check_four_triangles_identities(problem);
   }
 } // namespace
 

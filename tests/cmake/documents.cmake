@@ -1,5 +1,6 @@
 # The documents: the tutorial's tables and code excerpts, the figure of
-# plot_report.py, the Markdown of the repository.
+# plot_report.py, the Markdown of the repository, the size limits of its
+# files.
 
 # The error tables of doc/tutorial.md (made by doc/make_results.sh) are
 # those of three runs above, to their printed digits. Catches: results
@@ -54,3 +55,20 @@ add_test(NAME markdown_escaped_math
 set_tests_properties(markdown_escaped_math PROPERTIES LABELS quick
   PASS_REGULAR_EXPRESSION
   "md:1: '\\\\{' in inline math.*md:1: '\\\\}' in inline math.*md:1: '\\\\,' in inline math.*md:4: '\\\\\\\\' in display math")
+
+# The size limits of the repository (tests/check_code_size.py): no file
+# over 800 lines, no function of C++ or Python over 100 lines; it also
+# prints the size of the library. Catches: a file or a function that grew
+# past its limit.
+add_test(NAME code_size
+  COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/check_code_size.py
+          ${CMAKE_SOURCE_DIR})
+set_tests_properties(code_size PROPERTIES LABELS quick)
+# The same check on a planted tree: a C++ and a Python function of 101
+# lines and a file of 801 must be named, their twins of 100 and 800 not
+# (tests/check_code_size_planted.py). Catches: a checker that lets them
+# pass, or counts a line too many.
+add_test(NAME code_size_planted
+  COMMAND ${Python3_EXECUTABLE}
+          ${CMAKE_CURRENT_SOURCE_DIR}/check_code_size_planted.py)
+set_tests_properties(code_size_planted PROPERTIES LABELS quick)
