@@ -70,7 +70,9 @@ namespace membranes
    * not finite at a point) would end the program in WorkStream, which
    * aborts on exceptions of its threads: the first one is kept, the
    * remaining items are skipped, and it is thrown again here, on the
-   * calling thread, as from a loop without threads.
+   * calling thread, as from a loop without threads (hence not
+   * MeshWorker::mesh_loop(): benchmarks/README.md, "Cell loops that pass
+   * exceptions on").
    */
   template <typename Copy,
             typename Iterator,
