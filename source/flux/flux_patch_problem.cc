@@ -1,7 +1,6 @@
 #include <algorithm>
 #include <cmath>
 #include <deal.II/base/exceptions.h>
-#include <deal.II/lac/lapack_full_matrix.h>
 #include <membranes/flux/flux_patch_problem.h>
 #include <tuple>
 
@@ -12,56 +11,6 @@ namespace membranes
 {
   namespace
   {
-    /**
-     * Overwrite the lower triangle of the symmetric matrix @p L with its
-     * Cholesky factor (L Lᵀ = the matrix). Returns false if a pivot is not
-     * positive relative to the diagonal entry.
-     */
-    bool
-    cholesky_factorize(FullMatrix<double> &L)
-    {
-      const unsigned int n = L.m();
-      for (unsigned int j = 0; j < n; ++j)
-        {
-          double d = L(j, j);
-          for (unsigned int k = 0; k < j; ++k)
-            d -= L(j, k) * L(j, k);
-          if (!(d > 1e-14 * std::abs(L(j, j))))
-            return false;
-          L(j, j) = std::sqrt(d);
-          for (unsigned int i = j + 1; i < n; ++i)
-            {
-              for (unsigned int k = 0; k < j; ++k)
-                L(i, j) -= L(i, k) * L(j, k);
-              L(i, j) /= L(j, j);
-            }
-        }
-      return true;
-    }
-
-
-
-    /** Overwrite @p v with (L Lᵀ)⁻¹ v for the Cholesky factor @p L. */
-    void
-    cholesky_solve(const FullMatrix<double> &L, double *v)
-    {
-      const unsigned int n = L.m();
-      for (unsigned int i = 0; i < n; ++i)
-        {
-          for (unsigned int k = 0; k < i; ++k)
-            v[i] -= L(i, k) * v[k];
-          v[i] /= L(i, i);
-        }
-      for (unsigned int i = n; i-- > 0;)
-        {
-          for (unsigned int k = i + 1; k < n; ++k)
-            v[i] -= L(k, i) * v[k];
-          v[i] /= L(i, i);
-        }
-    }
-
-
-
     /** At most 8 sub-triangles per cell, and the circulation. */
     constexpr unsigned int max_cell_unknowns = 9;
 
@@ -113,7 +62,11 @@ namespace membranes
       r.reinit(m);
     for (unsigned int c = 0; c < n_cells; ++c)
       assemble_cell(c);
-    solve_system();
+    // The system [A Bᵀ; B 0] (x; y) = (b; c) of the minimization A and the
+    // constraints B (of full rank), by LU with pivoting.
+    matrix.compute_lu_factorization();
+    for (auto &r : rhs)
+      matrix.solve(r);
     write_fluxes(result);
   }
 
@@ -366,74 +319,6 @@ namespace membranes
             }
         for (unsigned int i = 0; i < 2; ++i)
           rhs[i](row) = partial[i] - known_total[i];
-      }
-  }
-
-
-
-  /**
-   * The system [A Bᵀ; B 0] (x; y) = (b; c) has A symmetric positive
-   * definite (the minimization) and B of full rank (the constraints), so
-   * that the Cholesky factors of A and of the Schur complement B A⁻¹ Bᵀ
-   * solve it; should round-off spoil that on a degenerate patch, LU with
-   * pivoting does. The factorizations are written out for these systems of
-   * a few dozen unknowns, on which LAPACK's calls are slower
-   * (benchmarks/README.md, "Choices measured in the code").
-   */
-  void
-  PatchProblem::solve_system()
-  {
-    const unsigned int n                 = n_x + n_cells;
-    const unsigned int n_c               = matrix.m() - n;
-    const auto         solve_by_cholesky = [&]() {
-      cholesky_factor.reinit(n, n);
-      cholesky_factor.fill(matrix, 0, 0, 0, 0);
-      if (!cholesky_factorize(cholesky_factor))
-        return false;
-      // A⁻¹ Bᵀ column by column, then the Schur complement B A⁻¹ Bᵀ.
-      a_inverse_bt.resize(n_c * n);
-      for (unsigned int c = 0; c < n_c; ++c)
-        {
-          for (unsigned int i = 0; i < n; ++i)
-            a_inverse_bt[c * n + i] = matrix(n + c, i);
-          cholesky_solve(cholesky_factor, &a_inverse_bt[c * n]);
-        }
-      schur_complement.reinit(n_c, n_c);
-      for (unsigned int c = 0; c < n_c; ++c)
-        for (unsigned int d = 0; d <= c; ++d)
-          for (unsigned int i = 0; i < n; ++i)
-            schur_complement(c, d) +=
-              matrix(n + c, i) * a_inverse_bt[d * n + i];
-      if (!cholesky_factorize(schur_complement))
-        return false;
-      multipliers.resize(n_c);
-      for (auto &r : rhs)
-        {
-          // x₀ = A⁻¹ b, then (B A⁻¹ Bᵀ) y = B x₀ − c and x = x₀ − A⁻¹ Bᵀ y.
-          cholesky_solve(cholesky_factor, r.data());
-          for (unsigned int c = 0; c < n_c; ++c)
-            {
-              multipliers[c] = -r[n + c];
-              for (unsigned int i = 0; i < n; ++i)
-                multipliers[c] += matrix(n + c, i) * r[i];
-            }
-          cholesky_solve(schur_complement, multipliers.data());
-          for (unsigned int c = 0; c < n_c; ++c)
-            {
-              r[n + c] = multipliers[c];
-              for (unsigned int i = 0; i < n; ++i)
-                r[i] -= a_inverse_bt[c * n + i] * multipliers[c];
-            }
-        }
-      return true;
-    };
-    if (!solve_by_cholesky())
-      {
-        LAPACKFullMatrix<double> lu(matrix.m(), matrix.m());
-        lu = matrix;
-        lu.compute_lu_factorization();
-        for (unsigned int i = 0; i < 2; ++i)
-          lu.solve(rhs[i]);
       }
   }
 

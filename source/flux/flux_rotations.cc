@@ -1,9 +1,11 @@
 #include <algorithm>
+#include <boost/serialization/array.hpp>
+#include <boost/serialization/vector.hpp>
 #include <deal.II/base/parallel.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <membranes/flux/flux_equilibration.h>
-#include <membranes/flux/ghost_cell_exchange.h>
 
 // The rotation relaxation of the equilibrated fluxes σ_ih: divergence-free
 // corrections around the vertices of the sub-mesh S_h and inside each cell
@@ -204,16 +206,28 @@ namespace membranes
   void
   FluxEquilibration<dim>::relax_rotations(const DoFHandler<dim> &dof_handler)
   {
-    Rotations              rotations   = rotations_around_vertices(dof_handler);
-    const unsigned int     n_triangles = basis.n_sub_triangles();
-    GhostCellExchange<dim> ghost_cells;
-    ghost_cells.reinit(dof_handler.get_triangulation(),
-                       dof_handler.get_communicator());
+    Rotations          rotations   = rotations_around_vertices(dof_handler);
+    const unsigned int n_triangles = basis.n_sub_triangles();
+    // σ_ih of the sub-triangles of a cell, from its owner to its ghosts.
+    using CellFluxes    = std::vector<Fluxes>;
+    const auto first_of = [&](const auto &cell) {
+      return sigma.begin() + cell->active_cell_index() * n_triangles;
+    };
+    const auto update_ghosts = [&]() {
+      GridTools::exchange_cell_data_to_ghosts<CellFluxes, DoFHandler<dim>>(
+        dof_handler,
+        [&](const auto &cell) {
+          return CellFluxes(first_of(cell), first_of(cell) + n_triangles);
+        },
+        [&](const auto &cell, const CellFluxes &fluxes) {
+          std::copy(fluxes.begin(), fluxes.end(), first_of(cell));
+        });
+    };
 
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
       for (const unsigned int kind : Rotations::sweep_order)
         {
-          ghost_cells.update_ghosts(sigma, n_triangles);
+          update_ghosts();
           for_each_vertex(rotations.vertices_of_kind[kind],
                           [&](const RotationVertex &p) {
                             const auto           &all = rotations.rotations;

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <deal.II/base/auto_derivative_function.h>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/thread_local_storage.h>
 #include <deal.II/base/utilities.h>
@@ -182,9 +183,8 @@ namespace membranes
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
-      if (!compiled_value)
-        return parsers().value(p);
-      const double result = compiled_value(p);
+      const double result =
+        compiled_value ? compiled_value(p) : parsers().value(p);
       check(result, p);
       return result;
     }
@@ -194,17 +194,12 @@ namespace membranes
                std::vector<double>           &values,
                const unsigned int = 0) const override
     {
-      if (compiled_value)
-        for (unsigned int q = 0; q < points.size(); ++q)
-          {
-            values[q] = compiled_value(points[q]);
-            check(values[q], points[q]);
-          }
-      else
+      const ThreadParsers *local = compiled_value ? nullptr : &parsers();
+      for (unsigned int q = 0; q < points.size(); ++q)
         {
-          const ThreadParsers &local = parsers();
-          for (unsigned int q = 0; q < points.size(); ++q)
-            values[q] = local.value(points[q]);
+          values[q] =
+            local ? local->value(points[q]) : compiled_value(points[q]);
+          check(values[q], points[q]);
         }
     }
 
@@ -267,7 +262,7 @@ namespace membranes
     set_gradient_step(const double step) const
     {
       if (!compiled_gradient)
-        parsers().step_size = step;
+        parsers().set_h(step);
     }
 
     /** The InputError for this entry, which should be @p allowed. */
@@ -278,11 +273,17 @@ namespace membranes
     }
 
   private:
-    /** The parsers of one thread, bound to that thread's point. */
-    struct ThreadParsers
+    /**
+     * The parsers of one thread, bound to that thread's point. Without a
+     * gradient entry, the gradient is deal.II's central differences
+     * (AutoDerivativeFunction, formula Euler) of value(), with the step of
+     * set_gradient_step() on this thread.
+     */
+    struct ThreadParsers : public AutoDerivativeFunction<dim>
     {
       explicit ThreadParsers(const Expression &e)
-        : function(e.entry, e.expression, 1, e.constants, point)
+        : AutoDerivativeFunction<dim>(1e-5)
+        , function(e.entry, e.expression, 1, e.constants, point)
       {
         if (!Utilities::trim(e.gradient_expression).empty())
           exact_gradient = std::make_unique<ParsedExpressionEntry<dim>>(
@@ -292,40 +293,32 @@ namespace membranes
       /** The parsers hold the address of #point. */
       ThreadParsers(const ThreadParsers &) = delete;
 
+      /** The value at @p p, unchecked (Expression checks it). */
       double
-      value(const Point<dim> &p) const
+      value(const Point<dim> &p, const unsigned int = 0) const override
       {
-        point               = p;
-        const double result = function.evaluate(0);
-        function.check(result, p, "value");
-        return result;
+        point = p;
+        return function.evaluate(0);
       }
 
       Tensor<1, dim>
-      gradient(const Point<dim> &p) const
+      gradient(const Point<dim> &p, const unsigned int = 0) const override
       {
-        Tensor<1, dim> gradient;
-        if (exact_gradient)
+        if (!exact_gradient)
           {
-            point = p;
+            const Tensor<1, dim> gradient =
+              AutoDerivativeFunction<dim>::gradient(p);
             for (unsigned int d = 0; d < dim; ++d)
-              gradient[d] = exact_gradient->evaluate(d);
-            exact_gradient->check(gradient, p);
+              function.check(gradient[d],
+                             p,
+                             "gradient (by finite differences)");
             return gradient;
           }
-        // The central differences of deal.II's AutoDerivativeFunction
-        // (formula Euler), in the same arithmetic.
+        Tensor<1, dim> gradient;
+        point = p;
         for (unsigned int d = 0; d < dim; ++d)
-          {
-            Tensor<1, dim> step;
-            step[d]              = step_size;
-            point                = p + step;
-            const double forward = function.evaluate(0);
-            point                = p - step;
-            gradient[d] = (forward - function.evaluate(0)) / (2 * step_size);
-          }
-        for (unsigned int d = 0; d < dim; ++d)
-          function.check(gradient[d], p, "gradient (by finite differences)");
+          gradient[d] = exact_gradient->evaluate(d);
+        exact_gradient->check(gradient, p);
         return gradient;
       }
 
@@ -334,7 +327,6 @@ namespace membranes
 
       ParsedExpressionEntry<dim>                  function;
       std::unique_ptr<ParsedExpressionEntry<dim>> exact_gradient;
-      double                                      step_size = 1e-5;
     };
 
     /** The parsers of the calling thread, made on its first call. */

@@ -51,18 +51,11 @@ namespace membranes
    *   the vertices, alone (ProblemData::exact_action_list(): u may be
    *   singular there).
    *
-   * Quadrature error below 0.01 % (displacements) and 0.05 % (λ) from
-   * 2000 DoFs on where u is smooth on each cell; the H1 errors at a
-   * singular vertex (a re-entrant corner, the tip of the slit), where no
-   * fixed rule converges, to a few % (measured against the composite
-   * reference rule of `Exact solution/Reference quadrature`,
-   * benchmarks/README.md, "`error_quadrature.sh`").
-   *
-   * VectorTools::integrate_difference() takes one pass and one evaluation
-   * of the exact solution per norm and membrane, five passes in all
-   * (benchmarks/README.md, "Error norms in one pass"), and with QGauss(2)
-   * its L2 errors come out 2 to 6 % low (the Gauss points are where the
-   * error of a bilinear interpolant is smallest).
+   * The quadrature error of these rules: benchmarks/README.md,
+   * "`error_quadrature.sh`". VectorTools::integrate_difference() takes the
+   * quadrature as an argument too, but makes one pass and one evaluation
+   * of the exact solution per norm and membrane (benchmarks/README.md,
+   * "Error norms in one pass").
    */
   /**
    * Where the exact λ jumps: the cells on which λ (or λ − λ_h) varies by

@@ -4,7 +4,7 @@
 #include <array>
 #include <boost/serialization/array.hpp>
 #include <deal.II/base/types.h>
-#include <deal.II/lac/full_matrix.h>
+#include <deal.II/lac/lapack_full_matrix.h>
 #include <deal.II/lac/vector.h>
 #include <utility>
 #include <vector>
@@ -139,10 +139,6 @@ namespace membranes
     void
     assemble_cell(const unsigned int c);
 
-    /** Solve the saddle point system for both membranes. */
-    void
-    solve_system();
-
     /** σ_ih^a on the sub-triangles of the patch, to @p result. */
     void
     write_fluxes(const std::vector<double *> &result) const;
@@ -184,15 +180,8 @@ namespace membranes
     std::vector<std::array<std::array<double, 3>, 2>> target;
 
     /** The matrix of the saddle point system and its two right-hand sides. */
-    FullMatrix<double>            matrix;
+    LAPACKFullMatrix<double>      matrix;
     std::array<Vector<double>, 2> rhs;
-    /**
-     * The work arrays of the solver: the Cholesky factor of the
-     * minimization block A, that of the Schur complement B A⁻¹ Bᵀ of the
-     * constraints B, the columns of A⁻¹ Bᵀ, and the multipliers.
-     */
-    FullMatrix<double>  cholesky_factor, schur_complement;
-    std::vector<double> a_inverse_bt, multipliers;
   };
 } // namespace membranes
 

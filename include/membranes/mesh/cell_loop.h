@@ -62,18 +62,17 @@ namespace membranes
    * the order of the items. Sums formed in the copier are therefore the
    * same, to the last bit, for any number of threads.
    *
-   * WorkStream hands the items to the threads in chunks; each chunk costs
-   * a synchronization of the pipeline between the threads and the copier.
-   * The loops of this program do little work per cell (a few microseconds),
-   * so chunks of `chunk_size` items instead of WorkStream's default of 8
-   * keep that cost small against the work (benchmarks/README.md, "The
-   * chunks of the cell loops").
+   * WorkStream hands the items to the threads in chunks of `chunk_size`
+   * items instead of its default of 8 (benchmarks/README.md, "The chunks of
+   * the cell loops, before and after").
    *
    * An exception thrown by the worker (an expression of the scene that is
    * not finite at a point) would end the program in WorkStream, which
    * aborts on exceptions of its threads: the first one is kept, the
    * remaining items are skipped, and it is thrown again here, on the
-   * calling thread, as from a loop without threads.
+   * calling thread, as from a loop without threads (hence not
+   * MeshWorker::mesh_loop(): benchmarks/README.md, "Cell loops that pass
+   * exceptions on").
    */
   template <typename Copy,
             typename Iterator,

@@ -99,7 +99,9 @@ namespace membranes
      * Write this process's piece of @p name of cycle @p cycle with
      * @p write_piece; on N > 1 processes, the first one writes the .pvtu
      * record of all pieces with @p write_record (given their file names);
-     * then the .pvd file over the cycles in @p written.
+     * then the .pvd file over the cycles in @p written. (Not
+     * DataOut::write_vtu_with_pvtu_record(), which opens the files itself:
+     * benchmarks/README.md, "Atomic output files".)
      */
     void
     write_cycle(
