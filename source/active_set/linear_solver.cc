@@ -7,9 +7,8 @@
 
 namespace membranes
 {
-  template <int dim>
-  LinearSolver<dim>::LinearSolver(const Parameters::LinearSolverType type,
-                                  const MPI_Comm mpi_communicator)
+  LinearSolver::LinearSolver(const Parameters::LinearSolverType type,
+                             const MPI_Comm mpi_communicator)
     : type(type)
     , mpi_communicator(mpi_communicator)
     , use_direct(false)
@@ -17,11 +16,9 @@ namespace membranes
 
 
 
-  template <int dim>
   void
-  LinearSolver<dim>::reinit(
-    const types::global_dof_index         n_unknowns,
-    const std::vector<std::vector<bool>> &constant_modes)
+  LinearSolver::reinit(const types::global_dof_index         n_unknowns,
+                       const std::vector<std::vector<bool>> &constant_modes)
   {
     const bool serial =
       (Utilities::MPI::n_mpi_processes(mpi_communicator) == 1);
@@ -34,18 +31,16 @@ namespace membranes
 
 
 
-  template <int dim>
   bool
-  LinearSolver<dim>::is_direct() const
+  LinearSolver::is_direct() const
   {
     return use_direct;
   }
 
 
 
-  template <int dim>
   void
-  LinearSolver<dim>::initialize_preconditioner(const MatrixType &matrix)
+  LinearSolver::initialize_preconditioner(const MatrixType &matrix)
   {
     // Smoothed aggregation (ML's default): lower-memory settings slow CG down
     // (benchmarks/README.md, "The settings of ML and the peak memory").
@@ -60,18 +55,16 @@ namespace membranes
 
 
 
-  template <int dim>
   bool
-  LinearSolver<dim>::has_preconditioner() const
+  LinearSolver::has_preconditioner() const
   {
     return amg != nullptr;
   }
 
 
 
-  template <int dim>
   const TrilinosWrappers::PreconditionAMG &
-  LinearSolver<dim>::preconditioner() const
+  LinearSolver::preconditioner() const
   {
     Assert(amg, ExcInternalError());
     return *amg;
@@ -79,29 +72,26 @@ namespace membranes
 
 
 
-  template <int dim>
   void
-  LinearSolver<dim>::clear()
+  LinearSolver::clear()
   {
     amg.reset();
   }
 
 
 
-  template <int dim>
   std::string
-  LinearSolver<dim>::method() const
+  LinearSolver::method() const
   {
     return use_direct ? "direct" : "cg-amg";
   }
 
 
 
-  template <int dim>
   void
-  LinearSolver<dim>::solve_direct(const MatrixType &matrix,
-                                  VectorType       &x,
-                                  const VectorType &rhs) const
+  LinearSolver::solve_direct(const MatrixType &matrix,
+                             VectorType       &x,
+                             const VectorType &rhs) const
   {
     SolverControl                                  control;
     TrilinosWrappers::SolverDirect::AdditionalData data(false,
@@ -109,8 +99,4 @@ namespace membranes
     TrilinosWrappers::SolverDirect                 solver(control, data);
     solver.solve(matrix, x, rhs);
   }
-
-
-
-  template class LinearSolver<2>;
 } // namespace membranes
