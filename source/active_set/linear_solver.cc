@@ -2,7 +2,11 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/sparse_direct.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/trilinos_solver.h>
+#include <deal.II/lac/vector.h>
 #include <membranes/active_set/linear_solver.h>
 
 namespace membranes
@@ -93,10 +97,45 @@ namespace membranes
                              VectorType       &x,
                              const VectorType &rhs) const
   {
-    SolverControl                                  control;
-    TrilinosWrappers::SolverDirect::AdditionalData data(false,
-                                                        direct_solver_package);
-    TrilinosWrappers::SolverDirect                 solver(control, data);
-    solver.solve(matrix, x, rhs);
+    if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
+      {
+        SolverControl                                  control;
+        TrilinosWrappers::SolverDirect::AdditionalData data(
+          false, direct_solver_package);
+        TrilinosWrappers::SolverDirect solver(control, data);
+        solver.solve(matrix, x, rhs);
+        return;
+      }
+    // UMFPACK factorizes deal.II's SparseMatrix: the rows of the Epetra
+    // matrix copied into one (SparseMatrix::copy_from() of a Trilinos matrix
+    // costs more than the factorization from a few thousand rows on).
+    const Epetra_CrsMatrix &epetra         = matrix.trilinos_matrix();
+    const auto              for_each_entry = [&epetra](const auto &f) {
+      for (int row = 0; row < epetra.NumMyRows(); ++row)
+        {
+          int     n_entries;
+          double *values;
+          int    *columns;
+          epetra.ExtractMyRowView(row, n_entries, values, columns);
+          for (int k = 0; k < n_entries; ++k)
+            f(epetra.GRID(row), epetra.GCID(columns[k]), values[k]);
+        }
+    };
+    std::vector<unsigned int> row_lengths(matrix.m());
+    for_each_entry([&](const int row, int, double) { ++row_lengths[row]; });
+    SparsityPattern sparsity(matrix.m(), matrix.n(), row_lengths);
+    for_each_entry([&](const int row, const int column, double) {
+      sparsity.add(row, column);
+    });
+    sparsity.compress();
+    SparseMatrix<double> serial_matrix(sparsity);
+    for_each_entry([&](const int row, const int column, const double value) {
+      serial_matrix.set(row, column, value);
+    });
+    SparseDirectUMFPACK umfpack;
+    umfpack.initialize(serial_matrix);
+    Vector<double> solution(rhs);
+    umfpack.solve(solution);
+    x = solution;
   }
 } // namespace membranes
