@@ -87,7 +87,10 @@ namespace membranes
   std::string
   LinearSolver::method() const
   {
-    return use_direct ? "direct" : "cg-amg";
+    if (!use_direct)
+      return "cg-amg";
+    return Utilities::MPI::n_mpi_processes(mpi_communicator) == 1 ? "UMFPACK" :
+                                                                    "MUMPS";
   }
 
 

@@ -20,8 +20,9 @@ namespace membranes
    * The linear solves inside the active set method: the condensed,
    * symmetric positive definite systems of one iteration.
    *
-   * - `direct`: a sparse LU factorization of the matrix, on any number of
-   *   processes.
+   * - `direct`: a sparse LU factorization of the matrix: UMFPACK
+   *   (SparseDirectUMFPACK) on one process, MUMPS through Trilinos Amesos
+   *   on several.
    * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
    *   multigrid, with the constant near-null-space modes reinit() is given:
    *   one per block of the coupled system of (u1, u2), one for s or w.
@@ -48,19 +49,16 @@ namespace membranes
     using MatrixType = TrilinosWrappers::SparseMatrix;
 
     /**
-     * The Amesos package of the direct solver: MUMPS, a multifrontal LU
-     * factorization with pivoting that runs on all processes of the
-     * matrix (Amesos_Klu, always available, gathers the matrix on one
-     * process and is less accurate on these systems).
+     * The Amesos package of the direct solver on several processes: MUMPS,
+     * a multifrontal LU factorization with pivoting that runs on all
+     * processes of the matrix (benchmarks/README.md, "The direct solver on
+     * one process", for UMFPACK on one).
      */
     static constexpr const char *direct_solver_package = "Amesos_Mumps";
 
     /**
-     * Largest problem that `auto` hands to the direct solver: on the scalar
-     * problems of the decoupled method, adaptive and uniform, Q1 and P1,
-     * CG with AMG is the faster from about a thousand unknowns on, since
-     * the direct solver factorizes the matrix of w at every active set
-     * iteration (benchmarks/README.md, `solver_crossover.py`).
+     * Largest problem that `auto` hands to the direct solver
+     * (benchmarks/README.md, "`solver_crossover.py`").
      */
     static constexpr types::global_dof_index direct_solver_dof_limit = 1000;
 
@@ -95,7 +93,10 @@ namespace membranes
     const TrilinosWrappers::PreconditionAMG &
     preconditioner() const;
 
-    /** Solve `matrix x = rhs` by the LU factorization of @p matrix. */
+    /**
+     * Solve `matrix x = rhs` by the LU factorization of @p matrix: on one
+     * process by UMFPACK, on a deal.II copy of @p matrix.
+     */
     void
     solve_direct(const MatrixType &matrix,
                  VectorType       &x,
@@ -130,7 +131,10 @@ namespace membranes
     void
     clear();
 
-    /** "direct" or "cg-amg": what the last reinit() chose. */
+    /**
+     * What the last reinit() chose: "UMFPACK" or "MUMPS" (the direct
+     * solver on one or on several processes) or "cg-amg".
+     */
     std::string
     method() const;
 
