@@ -110,8 +110,8 @@ namespace membranes
         return;
       }
     // UMFPACK factorizes deal.II's SparseMatrix: the rows of the Epetra
-    // matrix copied into one (SparseMatrix::copy_from() of a Trilinos matrix
-    // costs more than the factorization from a few thousand rows on).
+    // matrix copied into one, not by SparseMatrix::copy_from()
+    // (benchmarks/README.md, "The direct solver on one process").
     const Epetra_CrsMatrix &epetra         = matrix.trilinos_matrix();
     const auto              for_each_entry = [&epetra](const auto &f) {
       for (int row = 0; row < epetra.NumMyRows(); ++row)
