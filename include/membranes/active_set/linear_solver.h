@@ -94,8 +94,9 @@ namespace membranes
     preconditioner() const;
 
     /**
-     * Solve `matrix x = rhs` by the LU factorization of @p matrix: on one
-     * process by UMFPACK, on a deal.II copy of @p matrix.
+     * Solve `matrix x = rhs` by the LU factorization of @p matrix: by
+     * UMFPACK on a deal.II copy of @p matrix on one process, by MUMPS on
+     * several.
      */
     void
     solve_direct(const MatrixType &matrix,
