@@ -19,7 +19,10 @@
  *   constraints and the boundary values (DiscreteProblem::laplace_matrix());
  * - W: μ̄ A with the rows and columns of the active vertices eliminated (the
  *   contact lines W_a = 0), the matrix that the direct solver factorizes at
- *   every active set iteration.
+ *   every active set iteration: DecoupledSystem condenses it from the cell
+ *   matrices, with the same sparsity pattern and entries (but for the
+ *   diagonal of an active vertex that constrains hanging vertices, which
+ *   holds their shares here).
  *
  * Each is solved by factorization and solve, `repetitions` times, by MUMPS
  * through Amesos (TrilinosWrappers::SolverDirect with Amesos_Mumps, on the
