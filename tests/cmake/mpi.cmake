@@ -102,10 +102,9 @@ membranes_process_comparison(mpi_balanced case-m-quadrilateral.prm 5
 # UMFPACK and MUMPS, 2.7e-10 relative: 1e-9 there. Global refinement with
 # both methods on case M; adaptive refinement, driven by the residual and by
 # the flux estimator, on the shifted circle, whose contact zone is off the
-# centre:
-# on a mesh and data with mirror symmetries, round-off differences decide
-# which of two equal indicators is marked (see the method comparisons
-# above), here the numbers of processes.
+# centre: on a mesh and data with mirror symmetries, round-off differences
+# decide which of two equal indicators is marked (see the method
+# comparisons above), here the numbers of processes.
 membranes_process_comparison(mpi_p1_global case-m-triangle.prm 6
   SOLVER direct RTOL 1e-9 Solver/Method=coupled)
 membranes_process_comparison(mpi_p1_global_decoupled case-m-triangle.prm 6
