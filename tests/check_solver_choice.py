@@ -8,8 +8,9 @@ The program runs with ``Output/Directory=OUTDIR`` and its output is echoed.
 On every cycle, whose line ``Cycle k: ... N DoFs`` gives the DoFs of the
 pair (u1h, u2h), the scalar problems of the decoupled method have N/2
 unknowns each; every active set iteration of the cycle must say
-``direct`` if N/2 <= LIMIT and ``cg-amg`` otherwise, the choice that
-LinearSolver documents. The run must have cycles on both sides of LIMIT.
+``UMFPACK`` (the direct solver of one process) if N/2 <= LIMIT and
+``cg-amg`` otherwise, the choice that LinearSolver documents. The run, on
+one process, must have cycles on both sides of LIMIT.
 """
 import re
 import subprocess
@@ -34,7 +35,7 @@ for line in output.splitlines():
     iteration = re.search(r"active set iteration (\d+):.*decoupled, (\S+) \(",
                           line)
     if iteration:
-        wanted = "direct" if unknowns <= limit else "cg-amg"
+        wanted = "UMFPACK" if unknowns <= limit else "cg-amg"
         check(iteration.group(2) == wanted,
               "%d unknowns, iteration %s: %s (documented: %s)" % (
                   unknowns, iteration.group(1), iteration.group(2), wanted))

@@ -345,8 +345,8 @@ namespace membranes::Parameters
       "Linear solver",
       "auto",
       selection(linear_solvers),
-      "direct: sparse LU (Trilinos Amesos MUMPS), any number of "
-      "processes; cg-amg: CG with Trilinos ML AMG; auto: "
+      "direct: sparse LU (UMFPACK on one process, Trilinos Amesos "
+      "MUMPS on several); cg-amg: CG with Trilinos ML AMG; auto: "
       "direct up to 1000 unknowns on one process, cg-amg above.");
     prm.declare_entry("Tolerance",
                       "1e-10",

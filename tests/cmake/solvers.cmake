@@ -120,11 +120,13 @@ membranes_stopping_comparison(stopping_degenerate degenerate-free-boundary.prm
 membranes_stopping_comparison(stopping_case_m case-m-quadrilateral.prm 5
   Solver/Linear\ solver=cg-amg)
 
-# Linear solver = auto takes MUMPS up to 1000 unknowns per scalar problem
-# and CG-AMG above (LinearSolver::direct_solver_dof_limit, measured by
+# Linear solver = auto takes the direct solver, UMFPACK on one process, up
+# to 1000 unknowns per scalar problem and CG-AMG above
+# (LinearSolver::direct_solver_dof_limit, measured by
 # benchmarks/solver_crossover.py): every active set iteration of case M, 5
 # cycles (25 to 4225 unknowns), says so. Catches: a limit that is not the
-# documented one, or the size of the pair taken for that of one problem.
+# documented one, the size of the pair taken for that of one problem, or
+# MUMPS on one process.
 add_test(NAME solver_choice_auto
   COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/check_solver_choice.py
           1000 ${CMAKE_CURRENT_BINARY_DIR}/solver_choice_auto

@@ -139,7 +139,7 @@ namespace membranes
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
     const MPI_Comm             mpi_communicator;
-    LinearSolver<dim>          linear_solver;
+    LinearSolver               linear_solver;
 
   private:
     const std::string method;

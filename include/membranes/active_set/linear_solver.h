@@ -20,26 +20,19 @@ namespace membranes
    * The linear solves inside the active set method: the condensed,
    * symmetric positive definite systems of one iteration.
    *
-   * - `direct`: the sparse LU factorization of Trilinos Amesos
-   *   (TrilinosWrappers::SolverDirect with direct_solver_package) of the
-   *   distributed matrix itself, on any number of processes.
+   * - `direct`: a sparse LU factorization of the matrix: UMFPACK
+   *   (SparseDirectUMFPACK) on one process, MUMPS through Trilinos Amesos
+   *   on several.
    * - `cg-amg`: conjugate gradients preconditioned by Trilinos ML algebraic
    *   multigrid, with the constant near-null-space modes reinit() is given:
    *   one per block of the coupled system of (u1, u2), one for s or w.
    * - `auto`: direct up to direct_solver_dof_limit unknowns on one process,
-   *   cg-amg otherwise, on both cell types. Geometric multigrid is not
-   *   offered: deal.II 9.4 coarsens no simplex mesh and smooths on no
-   *   level of one, so it could serve Q1 only, and on quadrilaterals its
-   *   matrix-free form, built without SIMD in Debian's deal.II, makes a
-   *   CG solve 6 to 8 times slower than ML's AMG at 10⁶ DoFs for about
-   *   the same memory (benchmarks/README.md, "`gmg_floor.sh`").
+   *   cg-amg otherwise, on both cell types (benchmarks/README.md,
+   *   "`gmg_floor.sh`", for why geometric multigrid is not offered).
    *
-   * CG stops at the residual norm it is given (the active set method
-   * relates it to the size of the forces, not to the right-hand side, whose
-   * rows of constrained boundary DoFs can dwarf the interior ones on fine
-   * meshes), and starts from the vector it is given (the previous active set
-   * iterate, or the interpolated solution of the previous mesh), so later
-   * iterations of the active set method are cheap. It runs on any operator
+   * CG stops at the residual norm it is given, and starts from the vector
+   * it is given (the previous active set iterate, or the interpolated
+   * solution of the previous mesh). It runs on any operator
    * with a vmult(): a matrix, or a deal.II LinearOperator composed from one,
    * with a preconditioner composed from the AMG hierarchy P of
    * initialize_preconditioner(). DecoupledSystem solves for S on the
@@ -49,7 +42,6 @@ namespace membranes
    * onto the inactive vertices; CoupledSystem solves on the scaled system
    * D K D with D⁻¹ P D⁻¹, P the hierarchy of K.
    */
-  template <int dim>
   class LinearSolver
   {
   public:
@@ -57,19 +49,16 @@ namespace membranes
     using MatrixType = TrilinosWrappers::SparseMatrix;
 
     /**
-     * The Amesos package of the direct solver: MUMPS, a multifrontal LU
-     * factorization with pivoting that runs on all processes of the
-     * matrix (Amesos_Klu, always available, gathers the matrix on one
-     * process and is less accurate on these systems).
+     * The Amesos package of the direct solver on several processes: MUMPS,
+     * a multifrontal LU factorization with pivoting that runs on all
+     * processes of the matrix (benchmarks/README.md, "The direct solver on
+     * one process", for UMFPACK on one).
      */
     static constexpr const char *direct_solver_package = "Amesos_Mumps";
 
     /**
-     * Largest problem that `auto` hands to the direct solver: on the scalar
-     * problems of the decoupled method, adaptive and uniform, Q1 and P1,
-     * CG with AMG is the faster from about a thousand unknowns on, since
-     * the direct solver factorizes the matrix of w at every active set
-     * iteration (benchmarks/README.md, `solver_crossover.py`).
+     * Largest problem that `auto` hands to the direct solver
+     * (benchmarks/README.md, "`solver_crossover.py`").
      */
     static constexpr types::global_dof_index direct_solver_dof_limit = 1000;
 
@@ -104,7 +93,11 @@ namespace membranes
     const TrilinosWrappers::PreconditionAMG &
     preconditioner() const;
 
-    /** Solve `matrix x = rhs` by the LU factorization of @p matrix. */
+    /**
+     * Solve `matrix x = rhs` by the LU factorization of @p matrix: by
+     * UMFPACK on a deal.II copy of @p matrix on one process, by MUMPS on
+     * several.
+     */
     void
     solve_direct(const MatrixType &matrix,
                  VectorType       &x,
@@ -139,7 +132,10 @@ namespace membranes
     void
     clear();
 
-    /** "direct" or "cg-amg": what the last reinit() chose. */
+    /**
+     * What the last reinit() chose: "UMFPACK" or "MUMPS" (the direct
+     * solver on one or on several processes) or "cg-amg".
+     */
     std::string
     method() const;
 
