@@ -31,7 +31,7 @@ The first eleven print Markdown to standard output:
   rate), and the H^-1(omega) error of the action;
 * ``adaptive``: every sixth cycle and the last one of an adaptive run with
   an exact solution: DoFs, energy error, estimator, effectivity and the
-  action error;
+  action errors in L2(omega) and H^-1(omega);
 * ``solver``: per run and cycle the DoFs, active set iterations, active
   vertices, CG iterations and cumulative wall time;
 * ``identities``: per run the discrete identities of the last cycle (report
@@ -169,12 +169,14 @@ def adaptive(path):
     shown = [row for index, row in enumerate(rows)
              if index % 6 == 0 or index == len(rows) - 1]
     header = ["cycle", "DoFs", "energy error", "estimator $\\eta$",
-              "effectivity $\\eta$ / error", "action error on $\\omega$"]
+              "effectivity $\\eta$ / error", "action error on $\\omega$",
+              "action error in $H^{-1}(\\omega)$"]
     table = [[row["cycle"], row["dofs"], f"{value(row, 'err_energy'):.3e}",
               f"{value(row, 'estimator'):.3e}",
               f"{value(row, 'effectivity'):.2f}",
-              f"{value(row, 'err_lambda_L2'):.3e}"] for row in shown]
-    return markdown(header, table, "rrrrrr")
+              f"{value(row, 'err_lambda_L2'):.3e}",
+              f"{value(row, 'err_lambda_Hm1'):.3e}"] for row in shown]
+    return markdown(header, table, "rrrrrrr")
 
 
 def solver(arguments):
