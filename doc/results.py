@@ -59,8 +59,9 @@ The first eleven print Markdown to standard output:
 and ``<!-- end of results: NAME -->`` by the contents of BLOCK-FILE; it stops
 with an error (and leaves DOCUMENT as it is) if the markers are missing.
 
-``check`` compares the error table of block NAME of DOCUMENT with the table
-``errors`` makes from report.csv (of the kind whose header the block has):
+``check`` compares the table of block NAME of DOCUMENT with the table
+``errors`` (of the kind whose header the block has) or ``adaptive`` makes
+from report.csv:
 the same rows and columns, errors equal to 1e-3 relative (both are printed
 with four significant digits) and rates to 0.011 (two decimals). Without a
 block NAME, NAME is BLOCK-LABEL: the rows of the run LABEL (case ignored) in
@@ -407,12 +408,13 @@ def check(document, name, report):
     if not documented:
         raise ValueError(f"{document}, {name}: no table")
     header = documented[0][1:] if label else documented[0]
-    kinds = [kind for kind in ERROR_TABLES
-             if table_cells(errors(kind, [report]))[0] == header]
+    tables = [errors(kind, [report]) for kind in ERROR_TABLES] + \
+        [adaptive(report)]
+    kinds = [table for table in tables if table_cells(table)[0] == header]
     if not kinds:
-        raise ValueError(f"{document}, {name}: a header that no kind of "
-                         f"table errors has: {documented[0]}")
-    computed = table_cells(errors(kinds[0], [report]))[1:]
+        raise ValueError(f"{document}, {name}: a header that no table of "
+                         f"errors or adaptive has: {documented[0]}")
+    computed = table_cells(kinds[0])[1:]
     documented = run_rows(documented[1:], label) if label \
         else documented[1:]
     if len(documented) != len(computed):
