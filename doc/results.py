@@ -31,7 +31,7 @@ The first eleven print Markdown to standard output:
   rate), and the H^-1(omega) error of the action;
 * ``adaptive``: every sixth cycle and the last one of an adaptive run with
   an exact solution: DoFs, energy error, estimator, effectivity and the
-  action error;
+  action errors in L2(omega) and H^-1(omega);
 * ``solver``: per run and cycle the DoFs, active set iterations, active
   vertices, CG iterations and cumulative wall time;
 * ``identities``: per run the discrete identities of the last cycle (report
@@ -49,9 +49,9 @@ The first eleven print Markdown to standard output:
   of estimator ~ N^(-r) (least squares over the last half of the cycles),
   for scenes without an exact solution;
 * ``adaptivity``: one row per scene and cell type of the output directory of
-  benchmarks/adaptivity.sh: the rates of uniform and adaptive refinement,
-  the adaptive DoFs at the error of the finest uniform mesh divided by its
-  DoFs, and the effectivity band;
+  benchmarks/adaptivity.sh: the rates of uniform and adaptive refinement
+  and the effectivity band (the DoFs at equal error are in the block
+  adaptivity of benchmarks/README.md);
 * ``comparisons``: from the table.md of benchmarks/adaptivity.sh, only the
   comparisons at equal error and the PASS/FAIL lines.
 
@@ -59,8 +59,9 @@ The first eleven print Markdown to standard output:
 and ``<!-- end of results: NAME -->`` by the contents of BLOCK-FILE; it stops
 with an error (and leaves DOCUMENT as it is) if the markers are missing.
 
-``check`` compares the error table of block NAME of DOCUMENT with the table
-``errors`` makes from report.csv (of the kind whose header the block has):
+``check`` compares the table of block NAME of DOCUMENT with the table
+``errors`` (of the kind whose header the block has) or ``adaptive`` makes
+from report.csv:
 the same rows and columns, errors equal to 1e-3 relative (both are printed
 with four significant digits) and rates to 0.011 (two decimals). Without a
 block NAME, NAME is BLOCK-LABEL: the rows of the run LABEL (case ignored) in
@@ -169,12 +170,14 @@ def adaptive(path):
     shown = [row for index, row in enumerate(rows)
              if index % 6 == 0 or index == len(rows) - 1]
     header = ["cycle", "DoFs", "energy error", "estimator $\\eta$",
-              "effectivity $\\eta$ / error", "action error on $\\omega$"]
+              "effectivity $\\eta$ / error", "action error on $\\omega$",
+              "action error in $H^{-1}(\\omega)$"]
     table = [[row["cycle"], row["dofs"], f"{value(row, 'err_energy'):.3e}",
               f"{value(row, 'estimator'):.3e}",
               f"{value(row, 'effectivity'):.2f}",
-              f"{value(row, 'err_lambda_L2'):.3e}"] for row in shown]
-    return markdown(header, table, "rrrrrr")
+              f"{value(row, 'err_lambda_L2'):.3e}",
+              f"{value(row, 'err_lambda_Hm1'):.3e}"] for row in shown]
+    return markdown(header, table, "rrrrrrr")
 
 
 def solver(arguments):
@@ -288,7 +291,6 @@ def estimators(arguments):
 
 def adaptivity(directory):
     header = ["scene", "rate, uniform", "rate, adaptive",
-              "DoFs adaptive / uniform at equal error",
               "effectivity, largest / smallest"]
     table = []
     for scene, name in [("lshape", "L-shape"), ("slit", "slit")]:
@@ -296,15 +298,12 @@ def adaptivity(directory):
             prefix = os.path.join(directory, f"{scene}-{cells}-")
             uniform = read_report(prefix + "uniform/report.csv")
             adaptive_rows = read_report(prefix + "adaptive/report.csv")
-            target = value(uniform[-1], "err_energy")
-            n, _, _ = adaptivity_table.at_error(adaptive_rows, target)
             table.append([
                 f"{name} {cells.upper()}",
                 f"{adaptivity_table.rate(uniform)[0]:.3f}",
                 f"{adaptivity_table.rate(adaptive_rows)[0]:.3f}",
-                f"{n / value(uniform[-1], 'dofs'):.3f}",
                 f"{adaptivity_table.effectivity_band(adaptive_rows):.2f}"])
-    return markdown(header, table, "lrrrr")
+    return markdown(header, table, "lrrr")
 
 
 def comparisons(path):
@@ -409,12 +408,13 @@ def check(document, name, report):
     if not documented:
         raise ValueError(f"{document}, {name}: no table")
     header = documented[0][1:] if label else documented[0]
-    kinds = [kind for kind in ERROR_TABLES
-             if table_cells(errors(kind, [report]))[0] == header]
+    tables = [errors(kind, [report]) for kind in ERROR_TABLES] + \
+        [adaptive(report)]
+    kinds = [table for table in tables if table_cells(table)[0] == header]
     if not kinds:
-        raise ValueError(f"{document}, {name}: a header that no kind of "
-                         f"table errors has: {documented[0]}")
-    computed = table_cells(errors(kinds[0], [report]))[1:]
+        raise ValueError(f"{document}, {name}: a header that no table of "
+                         f"errors or adaptive has: {documented[0]}")
+    computed = table_cells(kinds[0])[1:]
     documented = run_rows(documented[1:], label) if label \
         else documented[1:]
     if len(documented) != len(computed):

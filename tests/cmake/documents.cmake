@@ -18,6 +18,17 @@ foreach(pair "case_m_quadrilateral;case-m-q1" "case_m_triangle;case-m-p1"
     FIXTURES_REQUIRED ${run})
 endforeach()
 
+# The table of the default run in doc/tutorial.md is that of a run of
+# parameters/default.prm as shipped (14 adaptive cycles). Catches: a
+# change of the default run's results that leaves the table behind.
+membranes_scene_test(default_run default.prm SETTINGS Output/Write\ vtu=false)
+add_test(NAME tutorial_table_default-run
+  COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/doc/results.py check
+          ${CMAKE_SOURCE_DIR}/doc/tutorial.md default-run
+          ${CMAKE_CURRENT_BINARY_DIR}/default_run/report.csv)
+set_tests_properties(tutorial_table_default-run PROPERTIES
+  FIXTURES_REQUIRED default_run)
+
 # The figure of source/plot_report.py: coinciding columns drawn once and
 # named together, reference slopes in N (tests/check_plot_report.py).
 # Catches: a curve hidden under another, slopes labelled in h on an axis

@@ -21,12 +21,12 @@ namespace membranes
    * quadrilaterals (FE_Q, MappingQ1, QGauss).
    *
    * Both membranes live in the same scalar space: one DoFHandler of this
-   * element numbers the vertices of the mesh, and the two membranes are the
-   * two blocks of its vectors (u1h = solution.block(0), u2h =
-   * solution.block(1)), the way deal.II's step-22 holds velocity and
-   * pressure. s = μ1 u1 + μ2 u2 and w = u1 − u2 are vector operations on
-   * the blocks, and the stiffness matrix of the mesh is one matrix A of the
-   * scalar element, μ_i A for membrane i.
+   * element numbers the vertices of the mesh, and the two membranes are two
+   * blocks with that one numbering (u1h = solution.block(0), u2h =
+   * solution.block(1); no FESystem, unlike step-22). s = μ1 u1 + μ2 u2 and
+   * w = u1 − u2 are vector operations on the blocks, and the stiffness
+   * matrix of the mesh is one matrix A of the scalar element, μ_i A for
+   * membrane i.
    *
    * On a mesh of axis-parallel rectangles (the square, the L-shape and the
    * slit, and every refinement of them) the mapping of each cell is a
