@@ -210,12 +210,13 @@ namespace
       DoFTools::make_hanging_node_constraints(dof_handler, constraints);
       constraints.close();
       dual_mesh.reinit(dof_handler);
-      problem.reinit(dof_handler, constraints, dual_mesh, MPI_COMM_WORLD);
+      problem.reinit(
+        dof_handler, relevant, constraints, dual_mesh, MPI_COMM_WORLD);
       action.reinit(problem);
       active_set.reinit(problem);
       ActiveSetSolver<dim> solver(
         parameters.solver, discretization, data, pcout, timer, MPI_COMM_WORLD);
-      solver.setup(problem, dof_handler, constraints);
+      solver.setup(problem, dof_handler);
       solution.reinit(std::vector<IndexSet>(2, owned), MPI_COMM_WORLD);
       solver.solve(problem, dof_handler, action, solution, active_set);
       ghosted_solution.reinit(std::vector<IndexSet>(2, owned),
@@ -235,8 +236,8 @@ namespace
       w_rhs.equ(mu2 / (mu1 + mu2), problem.lifted_loads(0));
       w_rhs.add(-mu1 / (mu1 + mu2), problem.lifted_loads(1));
 
-      const IndexSet &active = active_set.locally_owned();
-      MatrixType      w_matrix;
+      const IndexSet active = active_set.locally_owned(problem);
+      MatrixType     w_matrix;
       w_matrix.copy_from(problem.laplace_matrix());
       for (auto entry = w_matrix.begin(); entry != w_matrix.end(); ++entry)
         if (entry->row() != entry->column() &&
