@@ -250,11 +250,8 @@ namespace
                                            support_points);
 
       dual_mesh.reinit(dof_handler);
-      discrete_problem.reinit(dof_handler,
-                              relevant_dofs,
-                              constraints,
-                              dual_mesh,
-                              mpi_communicator);
+      discrete_problem.reinit(
+        dof_handler, relevant_dofs, constraints, dual_mesh, mpi_communicator);
       action.reinit(discrete_problem);
       active_set.reinit(discrete_problem);
       solver.setup(discrete_problem, dof_handler);

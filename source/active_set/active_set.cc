@@ -193,8 +193,7 @@ namespace membranes
             epsilon &&
           std::abs(w / u_scale) <= epsilon;
         active_flags[k] =
-          !degenerate &&
-          violation(discrete_problem, k, lambda, w, u_scale) > 0;
+          !degenerate && violation(discrete_problem, k, lambda, w, u_scale) > 0;
       }
   }
 
@@ -240,12 +239,12 @@ namespace membranes
     for (unsigned int k = 0; k < active_flags.size(); ++k)
       owned[positions[k]] = active_flags[k];
     std::vector<MPI_Request> requests;
-    partitioner->export_to_ghosted_array_start<double>(
-      0,
-      make_array_view(std::as_const(owned)),
-      make_array_view(buffer),
-      make_array_view(ghosts),
-      requests);
+    partitioner->export_to_ghosted_array_start<double>(0,
+                                                       make_array_view(
+                                                         std::as_const(owned)),
+                                                       make_array_view(buffer),
+                                                       make_array_view(ghosts),
+                                                       requests);
     partitioner->export_to_ghosted_array_finish<double>(make_array_view(ghosts),
                                                         requests);
 
@@ -286,9 +285,10 @@ namespace membranes
     const auto               &vertices = problem.vertices();
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const double v = is_active(k) ?
-                           violation(problem, k, action.lambda(k), 0, u_scale) :
-                           violation(problem, k, 0, problem.nodal_w(k, solution), u_scale);
+        const double v =
+          is_active(k) ?
+            violation(problem, k, action.lambda(k), 0, u_scale) :
+            violation(problem, k, 0, problem.nodal_w(k, solution), u_scale);
         if (v > epsilon)
           changes.push_back({vertices[k].dof, v / epsilon});
       }

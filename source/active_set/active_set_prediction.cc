@@ -85,12 +85,13 @@ namespace membranes
     std::vector<StatusChange> changes;
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
-        const auto  &a         = vertices[k];
-        const double violation = active_set.violation(problem,
-                                                      k,
-                                                      predicted_action.lambda(k),
-                                                      problem.nodal_w(k, iterate),
-                                                      u_scale);
+        const auto  &a = vertices[k];
+        const double violation =
+          active_set.violation(problem,
+                               k,
+                               predicted_action.lambda(k),
+                               problem.nodal_w(k, iterate),
+                               u_scale);
         if (violation > epsilon)
           changes.push_back({a.dof, violation / epsilon});
         else if (std::abs(violation) <= epsilon)

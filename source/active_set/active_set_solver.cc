@@ -141,11 +141,12 @@ namespace membranes
                                  const StoppingState        &stopping,
                                  Statistics                 &statistics) const
   {
-    const double tiny = std::numeric_limits<double>::min();
-    statistics.kkt_defects = KKTDefects(problem, action, active_set, solution);
-    statistics.kkt_residual = statistics.kkt_defects.relative_residual(std::max(action.force_scale(), tiny),
-                           std::max(action.contact_force_scale(), tiny),
-                           displacement_scale(solution));
+    const double tiny       = std::numeric_limits<double>::min();
+    statistics.kkt_defects  = KKTDefects(problem, action, active_set, solution);
+    statistics.kkt_residual = statistics.kkt_defects.relative_residual(
+      std::max(action.force_scale(), tiny),
+      std::max(action.contact_force_scale(), tiny),
+      displacement_scale(solution));
     if (stopping.balanced)
       {
         statistics.linearization_estimate =

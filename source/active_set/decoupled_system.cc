@@ -51,17 +51,14 @@ namespace membranes
     const double mu_bar = this->data.mu_bar;
     obstacle_matrix.copy_from(problem.laplace_matrix());
     obstacle_matrix *= mu_bar;
-    this->for_each_row(problem,
-                       obstacle_matrix,
-                       active_set,
-                       [mu_bar](
-                         const typename ActiveSetSystem<dim>::MatrixRow &row) {
-                         for (int e = 0; e < row.n_entries; ++e)
-                           if (row.active || row.active_column(e))
-                             row.values[e] = (row.column(e) == row.dof) ?
-                                               mu_bar * row.stiffness_diagonal :
-                                               0;
-                       });
+    const auto eliminate =
+      [mu_bar](const typename ActiveSetSystem<dim>::MatrixRow &row) {
+        for (int e = 0; e < row.n_entries; ++e)
+          if (row.active || row.active_column(e))
+            row.values[e] =
+              (row.column(e) == row.dof) ? mu_bar * row.stiffness_diagonal : 0;
+      };
+    this->for_each_row(problem, obstacle_matrix, active_set, eliminate);
   }
 
 

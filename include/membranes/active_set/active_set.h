@@ -132,8 +132,8 @@ namespace membranes
 
     const MPI_Comm             mpi_communicator;
     std::vector<std::uint64_t> visited;
-    unsigned int          n_cycles;
-    bool                  least_index_rule;
+    unsigned int               n_cycles;
+    bool                       least_index_rule;
   };
 
 

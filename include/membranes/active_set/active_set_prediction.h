@@ -46,12 +46,12 @@ namespace membranes
    * guarantee where A has positive entries off the diagonal, and l1-Jacobi
    * (the divisor ‖A_a‖₁) takes half the step of plain Jacobi on the rows
    * that sum to zero (benchmarks/README.md, "The prediction of the active
-   * set, before and after", compares the three). Each sweep carries the contact information one layer further:
-   * penetrated vertices are clamped and lift their neighbours, active
-   * vertices pulled apart are released with the ones behind them. Where the
-   * predicted test is within the band of indifference of ActiveSet, the
-   * prediction has nothing to say and the plain test on the iterate
-   * decides: a vertex that the solves keep penetrating by a few ε is
+   * set, before and after", compares the three). Each sweep carries the contact
+   * information one layer further: penetrated vertices are clamped and lift
+   * their neighbours, active vertices pulled apart are released with the ones
+   * behind them. Where the predicted test is within the band of indifference of
+   * ActiveSet, the prediction has nothing to say and the plain test on the
+   * iterate decides: a vertex that the solves keep penetrating by a few ε is
    * clamped by the sweeps to a contact force within the band, and without
    * the plain test it would stay inactive until the prediction wants no
    * change at all (an extra iteration on the finest meshes of a degenerate

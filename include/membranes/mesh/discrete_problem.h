@@ -229,8 +229,8 @@ namespace membranes
 
     std::array<AffineConstraints<double>, 2> membrane_constraints;
     TrilinosWrappers::SparseMatrix           matrix;
-    std::array<VectorType, 2>      load_vectors;
-    std::array<VectorType, 2>      lifted_load_vectors;
+    std::array<VectorType, 2>                load_vectors;
+    std::array<VectorType, 2>                lifted_load_vectors;
     /**
      * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
      * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
