@@ -51,20 +51,12 @@ namespace membranes
     // error of forces of tension μ̄.
     // In the same pass, λ_a of both formulas, which the active set method
     // reads many times per iteration.
-    // The terms are those of stiffness_term() and load_term(), read from
-    // the local storage of the vectors.
     const auto  &vertices  = problem.vertices();
     const auto  &positions = problem.local_positions();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
-    std::array<const double *, 2> values, products, load_values, lifted_values;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        values[i]        = solution.block(i).begin();
-        products[i]      = stiffness_products[i].begin();
-        load_values[i]   = problem.loads(i).begin();
-        lifted_values[i] = problem.lifted_loads(i).begin();
-      }
+    const std::array<const double *, 2> values = {solution.block(0).begin(),
+                                                  solution.block(1).begin()};
     membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
       {
@@ -73,9 +65,8 @@ namespace membranes
         std::array<double, 2> stiffness, loads;
         for (unsigned int i = 0; i < 2; ++i)
           {
-            loads[i]     = load_values[i][p];
-            stiffness[i] = data.mu[i] * products[i][p] +
-                           (load_values[i][p] - lifted_values[i][p]);
+            stiffness[i] = stiffness_term(problem, i, k);
+            loads[i]     = load_term(problem, i, k);
           }
         for (unsigned int i = 0; i < 2; ++i)
           membrane_lambdas[k][i] = (i == 0 ? 1. : -1.) *
