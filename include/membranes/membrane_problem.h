@@ -27,6 +27,13 @@ namespace membranes
 {
   using namespace dealii;
 
+  template <int dim>
+  class FluxReconstruction;
+  template <int dim>
+  class FluxEquilibration;
+
+
+
   /**
    * The driver of one run: the contact problem (1.1) between two membranes,
    * discretized by P1/Q1 finite elements (the reduced problem (3.4)),
@@ -52,13 +59,6 @@ namespace membranes
    * reduction, and the terminal and report.csv are written by the first
    * process. One process is the case N = 1 of the same code.
    */
-  template <int dim>
-  class FluxReconstruction;
-  template <int dim>
-  class FluxEquilibration;
-
-
-
   template <int dim>
   class MembraneProblem
   {

@@ -17,9 +17,9 @@ namespace membranes
   void
   DiscreteAction<dim>::reinit(const DiscreteProblem<dim> &problem)
   {
-    for (auto &product : stiffness_products)
-      product.reinit(problem.locally_owned_dofs(),
-                     problem.get_mpi_communicator());
+    for (auto &vector : stiffness_terms)
+      vector.reinit(problem.locally_owned_dofs(),
+                    problem.get_mpi_communicator());
   }
 
 
@@ -33,14 +33,20 @@ namespace membranes
            ExcMessage("DiscreteAction::compute() reads the locally owned "
                       "DoFs of the solution by position (see "
                       "DiscreteProblem::local_positions())."));
-    // The two terms of (4.5) at every vertex: μ_i ∫ ∇u_ih·∇φ as μ_i times
+    // The stiffness term of (4.5) at every DoF, μ_i ∫ ∇u_ih·∇φ: μ_i times
     // the product of A with the nodal values U_i of membrane i, block i of
     // the solution (those of hanging nodes follow from their parents, whose
-    // columns hold the condensed couplings; those on ∂ω enter through the
-    // lifted loads, see stiffness_term()), and the loads ∫ f_i φ of this
-    // mesh.
+    // columns hold the condensed couplings), plus the columns of ∂ω: the
+    // loads minus the lifted loads, μ_i Σ_{b ∈ ∂ω} A_ab g_i(b).
     for (unsigned int i = 0; i < 2; ++i)
-      problem.laplace_matrix().vmult(stiffness_products[i], solution.block(i));
+      {
+        problem.laplace_matrix().vmult(stiffness_terms[i], solution.block(i));
+        stiffness_terms[i] *= data.mu[i];
+        stiffness_terms[i].add(1.,
+                               problem.loads(i),
+                               -1.,
+                               problem.lifted_loads(i));
+      }
 
     // The size of the terms that (4.5) balances at a: the stiffness term
     // μ_i ∫ ∇u_ih·∇φ_a is a sum whose largest part is the diagonal one,
@@ -51,19 +57,16 @@ namespace membranes
     // error of forces of tension μ̄.
     // In the same pass, λ_a of both formulas, which the active set method
     // reads many times per iteration.
-    // The terms are those of stiffness_term() and load_term(), read from
-    // the local storage of the vectors.
     const auto  &vertices  = problem.vertices();
     const auto  &positions = problem.local_positions();
     const double mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
     double       local_max = 0, local_contact_max = 0;
-    std::array<const double *, 2> values, products, load_values, lifted_values;
+    std::array<const double *, 2> values, terms, load_values;
     for (unsigned int i = 0; i < 2; ++i)
       {
-        values[i]        = solution.block(i).begin();
-        products[i]      = stiffness_products[i].begin();
-        load_values[i]   = problem.loads(i).begin();
-        lifted_values[i] = problem.lifted_loads(i).begin();
+        values[i]      = solution.block(i).begin();
+        terms[i]       = stiffness_terms[i].begin();
+        load_values[i] = problem.loads(i).begin();
       }
     membrane_lambdas.resize(vertices.size());
     for (unsigned int k = 0; k < vertices.size(); ++k)
@@ -73,9 +76,8 @@ namespace membranes
         std::array<double, 2> stiffness, loads;
         for (unsigned int i = 0; i < 2; ++i)
           {
+            stiffness[i] = terms[i][p];
             loads[i]     = load_values[i][p];
-            stiffness[i] = data.mu[i] * products[i][p] +
-                           (load_values[i][p] - lifted_values[i][p]);
           }
         for (unsigned int i = 0; i < 2; ++i)
           membrane_lambdas[k][i] = (i == 0 ? 1. : -1.) *
@@ -140,11 +142,7 @@ namespace membranes
                                       const unsigned int          i,
                                       const unsigned int          k) const
   {
-    // μ_i (A U_i)_a with the columns of the free DoFs, plus those of ∂ω:
-    // the loads minus the lifted loads, μ_i Σ_{b ∈ ∂ω} A_ab g_i(b).
-    const unsigned int p = problem.local_positions()[k];
-    return data.mu[i] * stiffness_products[i].begin()[p] +
-           (problem.loads(i).begin()[p] - problem.lifted_loads(i).begin()[p]);
+    return stiffness_terms[i].begin()[problem.local_positions()[k]];
   }
 
 

@@ -145,8 +145,8 @@ namespace membranes
   private:
     const ProblemData<dim> &data;
 
-    /** The products A U_i of the last solution (locally owned DoFs). */
-    std::array<VectorType, 2> stiffness_products;
+    /** The stiffness terms μ_i ∫ ∇u_ih·∇φ of the last solution. */
+    std::array<VectorType, 2> stiffness_terms;
 
     /** λ_a from formula i of (4.5), by vertex, of the last compute(). */
     std::vector<std::array<double, 2>> membrane_lambdas;
