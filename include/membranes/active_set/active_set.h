@@ -142,7 +142,7 @@ namespace membranes
    * The active set of the primal-dual active set method (ActiveSetSolver):
    * the set A ⊂ V_h of the vertices where the membranes are in contact, its
    * initial value on a new mesh and its update from an iterate. The linear
-   * systems impose it (ActiveSetSystem::assemble()).
+   * systems impose it (ActiveSetSystem::set_active_set()).
    *
    * With W_a = u1h(a) − u2h(a) (DiscreteProblem::nodal_w()) and the nodal
    * multiplier Λ_a = λ_a of (4.5), the active set is
@@ -244,7 +244,7 @@ namespace membranes
      * The active vertices among the locally relevant ones of the mesh of
      * @p problem, by a ghost
      * exchange: the owner of each vertex decides, every process that shares
-     * a cell with it learns the decision. ActiveSetSystem::assemble()
+     * a cell with it learns the decision. ActiveSetSystem::set_active_set()
      * imposes them on the linear problem of an iteration: as constraint
      * lines u1(a) = u2(a) in CoupledSystem, as the projection Π (and, in
      * the matrix of W, constraint lines W_a = 0) in DecoupledSystem.
