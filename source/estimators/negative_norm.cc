@@ -204,14 +204,18 @@ namespace membranes
       DoFTools::make_zero_boundary_constraints(dof_handler, id, constraints);
     constraints.close();
 
-    DynamicSparsityPattern dsp(relevant);
-    DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
-    SparsityTools::distribute_sparsity_pattern(dsp,
-                                               owned,
-                                               mpi_communicator,
-                                               relevant);
+    // The pattern is freed before the matrix is assembled and its AMG
+    // hierarchy built, the peak memory of a run with errors.
     TrilinosWrappers::SparseMatrix matrix;
-    matrix.reinit(owned, owned, dsp, mpi_communicator);
+    {
+      DynamicSparsityPattern dsp(relevant);
+      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
+      SparsityTools::distribute_sparsity_pattern(dsp,
+                                                 owned,
+                                                 mpi_communicator,
+                                                 relevant);
+      matrix.reinit(owned, owned, dsp, mpi_communicator);
+    }
     TrilinosWrappers::MPI::Vector rhs(owned, mpi_communicator);
     assemble(dof_handler, constraints, rho, jump, matrix, rhs);
 
