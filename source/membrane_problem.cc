@@ -372,7 +372,15 @@ namespace membranes
       hanging_node_constraints,
       discrete_problem.locally_owned_dofs(),
       mpi_communicator);
-    FluxRecord flux;
+    Vector<double> flux_indicators;
+    FluxRecord     flux = ErrorEstimator<dim>(discretization, data)
+                        .flux_estimate(dof_handler,
+                                       ghosted_solution,
+                                       dual_mesh,
+                                       lambda_h,
+                                       *flux_equilibration,
+                                       flux_indicators,
+                                       mpi_communicator);
     if (parameters.output.flux_reconstruction)
       {
         const auto identities = flux_reconstruction->identities(
@@ -381,21 +389,6 @@ namespace membranes
         flux.conservation_defect = identities.conservation_defect;
         flux.balance_defect      = identities.balance_defect;
       }
-
-    Vector<double> flux_indicators;
-    const auto     estimate = ErrorEstimator<dim>(discretization, data)
-                            .flux_estimate(dof_handler,
-                                           ghosted_solution,
-                                           dual_mesh,
-                                           lambda_h,
-                                           *flux_equilibration,
-                                           flux_indicators,
-                                           mpi_communicator);
-    flux.estimator   = estimate.eta;
-    flux.flux        = estimate.flux;
-    flux.oscillation = estimate.oscillation;
-    flux.contact     = estimate.contact;
-    flux.boundary    = estimate.boundary;
     if (parameters.refinement.estimator == Parameters::Estimator::flux)
       indicators.swap(flux_indicators);
     return flux;

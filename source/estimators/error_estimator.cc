@@ -420,7 +420,7 @@ namespace membranes
 
 
   template <int dim>
-  typename ErrorEstimator<dim>::FluxEstimate
+  FluxRecord
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>        &dof_handler,
     const BlockVectorType        &ghosted_solution,
@@ -448,16 +448,12 @@ namespace membranes
       },
       [&](const FluxTerms &terms) { sums += terms; });
 
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        sums.flux[i] = Utilities::MPI::sum(sums.flux[i], mpi_communicator);
-        sums.residual[i] =
-          Utilities::MPI::sum(sums.residual[i], mpi_communicator);
-      }
+    Utilities::MPI::sum(sums.flux, mpi_communicator, sums.flux);
+    Utilities::MPI::sum(sums.residual, mpi_communicator, sums.residual);
     sums.contact = Utilities::MPI::sum(sums.contact, mpi_communicator);
 
-    FluxEstimate estimate;
-    estimate.eta         = std::sqrt(sums.eta_squared());
+    FluxRecord estimate;
+    estimate.estimator   = std::sqrt(sums.eta_squared());
     estimate.flux        = std::sqrt(sums.flux[0] + sums.flux[1]);
     estimate.oscillation = std::sqrt(sums.residual[0] + sums.residual[1]);
     estimate.contact     = std::sqrt(2 * sums.contact);
@@ -528,13 +524,10 @@ namespace membranes
     const BlockVectorType &ghosted_solution,
     const MPI_Comm         mpi_communicator) const
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
-    const Quadrature<dim - 1> quadrature =
-      fe.reference_cell().is_simplex() ?
-        Quadrature<dim - 1>(QGaussSimplex<dim - 1>(3)) :
-        Quadrature<dim - 1>(QGauss<dim - 1>(3));
-    FEFaceValues<dim> face_values(*discretization.mapping,
-                                  fe,
+    // An edge is a line on triangles too: QGaussSimplex<1> is QGauss<1>.
+    const QGauss<dim - 1> quadrature(3);
+    FEFaceValues<dim>     face_values(*discretization.mapping,
+                                  *discretization.fe,
                                   quadrature,
                                   update_values | update_quadrature_points |
                                     update_JxW_values);

@@ -5,8 +5,6 @@
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/mapping_cartesian.h>
-#include <deal.II/fe/mapping_fe.h>
-#include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
@@ -19,35 +17,6 @@ namespace membranes
 {
   namespace
   {
-    template <int dim>
-    std::unique_ptr<FiniteElement<dim>>
-    make_fe(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<FE_SimplexP<dim>>(1);
-      return std::make_unique<FE_Q<dim>>(1);
-    }
-
-    template <int dim>
-    std::unique_ptr<Mapping<dim>>
-    make_mapping(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<MappingFE<dim>>(FE_SimplexP<dim>(1));
-      return std::make_unique<MappingQ1<dim>>();
-    }
-
-    template <int dim>
-    Quadrature<dim>
-    make_cell_quadrature(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return QGaussSimplex<dim>(3);
-      return QGauss<dim>(3);
-    }
-
-
-
     /**
      * A Gmsh file announces how many nodes and elements follow, and
      * GridIn allocates that much before it reads them: reject a count that
@@ -178,9 +147,13 @@ namespace membranes
   template <int dim>
   Discretization<dim>::Discretization(const Parameters::CellType cell_type)
     : cell_type(cell_type)
-    , fe(make_fe<dim>(cell_type))
-    , mapping(make_mapping<dim>(cell_type))
-    , cell_quadrature(make_cell_quadrature<dim>(cell_type))
+    , fe(cell_type == Parameters::CellType::triangle ?
+           std::unique_ptr<FiniteElement<dim>>(new FE_SimplexP<dim>(1)) :
+           std::make_unique<FE_Q<dim>>(1))
+    , mapping(
+        fe->reference_cell().template get_default_linear_mapping<dim>().clone())
+    , cell_quadrature(
+        fe->reference_cell().template get_gauss_type_quadrature<dim>(3))
     , dual_cell_quadrature(fe->reference_cell(), 2)
   {}
 

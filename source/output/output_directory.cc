@@ -64,24 +64,25 @@ namespace membranes
       const ssize_t length = ::pread(file, text, sizeof(text) - 1, 0);
       return length > 0 ? std::string(text, length) : "";
     }
+
+    /**
+     * Create @p directory and its parents where missing; whether it was
+     * missing. An InputError naming `Output/Directory` if it cannot be made.
+     */
+    bool
+    create_directory(const std::string &directory)
+    {
+      std::error_code error;
+      const bool      created = fs::create_directories(directory, error);
+      if (error || !fs::is_directory(directory))
+        throw Parameters::invalid_entry(
+          "Output/Directory",
+          directory,
+          "cannot create this directory (" +
+            (error ? error.message() : "a file of that name exists") + ")");
+      return created;
+    }
   } // namespace
-
-
-
-  bool
-  create_directory(const std::string &directory)
-  {
-    std::error_code error;
-    const bool      created = fs::create_directories(directory, error);
-    if (error || !fs::is_directory(directory))
-      throw Parameters::invalid_entry("Output/Directory",
-                                      directory,
-                                      "cannot create this directory (" +
-                                        (error ? error.message() :
-                                                 "a file of that name exists") +
-                                        ")");
-    return created;
-  }
 
 
 

@@ -11,6 +11,7 @@
 #include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
+#include <membranes/output/report.h>
 #include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
 
@@ -52,8 +53,6 @@ namespace membranes
    * vertices but not in between; it is the contact term of the estimators
    * of Part 2 of the paper and of Dabaghi, Martin and Vohralík for this
    * problem, there with equilibrated fluxes instead of residuals.
-   * The result drives adaptive refinement; η/|||e||| is reported as the
-   * effectivity index when the exact solution is known.
    *
    * The edge jumps are computed with FEInterfaceValues on quadrilaterals
    * (Q1: the normal derivative varies along an edge); on triangles (P1,
@@ -118,28 +117,6 @@ namespace membranes
     using VectorType      = TrilinosWrappers::MPI::Vector;
     using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
-    /**
-     * The flux estimator η and its parts, over all processes: η² =
-     * Σ_i (η_F,i + η_R,i)² + 2 B.
-     */
-    struct FluxEstimate
-    {
-      double eta = 0;
-      /** (Σ_i η_F,i²)^{1/2}: the distance of σ_ih from −μ_i ∇u_ih. */
-      double flux = 0;
-      /** (Σ_i η_R,i²)^{1/2}: the residual f_i + s_i λ̃_h − div σ_ih. */
-      double oscillation = 0;
-      /** (2 B)^{1/2}: the contact term. */
-      double contact = 0;
-      /**
-       * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
-       * g_2 = g2: the size of the energy of a lifting of the boundary
-       * data error into the cells along ∂ω (constant 1), which the
-       * argument for η assumes to vanish. Not part of η.
-       */
-      double boundary = 0;
-    };
-
     ErrorEstimator(const Discretization<dim> &discretization,
                    const ProblemData<dim>    &data);
 
@@ -161,9 +138,10 @@ namespace membranes
 
     /**
      * The flux estimator: the same with the equilibrated fluxes of
-     * @p flux_equilibration and the nodal λ_a of @p lambda_h.
+     * @p flux_equilibration and the nodal λ_a of @p lambda_h; η and its
+     * parts, over all processes, in the FluxRecord (its defects empty).
      */
-    FluxEstimate
+    FluxRecord
     flux_estimate(const DoFHandler<dim>        &dof_handler,
                   const BlockVectorType        &ghosted_solution,
                   const DualMesh<dim>          &dual_mesh,
@@ -184,7 +162,12 @@ namespace membranes
                    const VectorType           &lambda_h,
                    Vector<double>             &indicators) const;
 
-    /** The boundary data part of FluxEstimate. */
+    /**
+     * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
+     * g_2 = g2: the size of the energy of a lifting of the boundary data
+     * error into the cells along ∂ω (constant 1), which the argument for η
+     * assumes to vanish. Not part of η.
+     */
     double
     boundary_data_part(const DoFHandler<dim> &dof_handler,
                        const BlockVectorType &ghosted_solution,

@@ -16,13 +16,6 @@ namespace membranes
   };
 
   /**
-   * Create @p directory and its parents where missing; whether it was
-   * missing. An InputError naming `Output/Directory` if it cannot be made.
-   */
-  bool
-  create_directory(const std::string &directory);
-
-  /**
    * `Output/Directory`, held by one run for its whole life, so that the
    * directory holds the results of that run only, and says how they were
    * made.

@@ -77,7 +77,7 @@ namespace membranes
   struct FluxRecord
   {
     /**
-     * The flux estimator and its parts (ErrorEstimator::FluxEstimate): the
+     * The flux estimator and its parts (ErrorEstimator::flux_estimate()): the
      * flux part (Σ_i η_F,i²)^{1/2}, the oscillation part (Σ_i η_R,i²)^{1/2}
      * and the contact part (2 B)^{1/2}; the boundary data part, not part of
      * the estimator.
