@@ -359,8 +359,7 @@ namespace membranes
           squares[k] += cell_squares[k];
       });
 
-    for (double &square : squares)
-      square = Utilities::MPI::sum(square, mpi_communicator);
+    Utilities::MPI::sum(squares, mpi_communicator, squares);
     return {{{std::sqrt(squares[0]), std::sqrt(squares[1])}},
             {{std::sqrt(squares[2]), std::sqrt(squares[3])}},
             std::sqrt(squares[4] + squares[5]),
