@@ -46,6 +46,37 @@ namespace membranes
 
 
 
+  /**
+   * What one thread needs on a cell: u_ih, ∇u_ih, Δu_ih (zero unless
+   * computed), σ_ih, div σ_ih and λ̃_h at the quadrature points of the
+   * pieces K ∩ D_a.
+   */
+  template <int dim>
+  struct ErrorEstimator<dim>::CellScratch
+  {
+    CellScratch(const Discretization<dim> &discretization,
+                const DualMesh<dim>       &dual_mesh,
+                const VectorType          &lambda_h,
+                const UpdateFlags          flags)
+      : values(discretization, dual_mesh, lambda_h, flags)
+    {
+      for (unsigned int i = 0; i < 2; ++i)
+        {
+          u[i].resize(values.fe_values.n_quadrature_points);
+          grad_u[i].resize(values.fe_values.n_quadrature_points);
+          laplacian[i].assign(values.fe_values.n_quadrature_points, 0.0);
+        }
+    }
+
+    DualCellValues<dim>                        values;
+    std::array<std::vector<double>, 2>         u, laplacian;
+    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+    std::vector<Tensor<1, dim>>                flux;
+    std::vector<double>                        divergence, lambda;
+  };
+
+
+
   template <int dim>
   void
   ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
@@ -61,27 +92,6 @@ namespace membranes
     // function has no ∂²/∂x², ∂²/∂y²), not on other quadrilaterals.
     const bool with_laplacians =
       !fe.reference_cell().is_simplex() && !discretization.rectangles();
-    struct Scratch
-    {
-      Scratch(const Discretization<dim> &discretization,
-              const DualMesh<dim>       &dual_mesh,
-              const VectorType          &lambda_h,
-              const bool                 with_laplacians)
-        : values(discretization,
-                 dual_mesh,
-                 lambda_h,
-                 update_values | update_JxW_values |
-                   (with_laplacians ? update_hessians : update_default))
-      {
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            u[i].resize(values.fe_values.n_quadrature_points);
-            laplacian[i].assign(values.fe_values.n_quadrature_points, 0.0);
-          }
-      }
-      DualCellValues<dim>                values;
-      std::array<std::vector<double>, 2> u, laplacian;
-    };
     const std::array<double, 2> sign{{1., -1.}};
 
     // Each cell adds to its own indicator only: nothing to copy.
@@ -90,12 +100,15 @@ namespace membranes
     run_on_cells<NoCopy>(
       dof_handler,
       [&]() {
-        return std::make_unique<Scratch>(discretization,
-                                         dual_mesh,
-                                         lambda_h,
-                                         with_laplacians);
+        return std::make_unique<CellScratch>(discretization,
+                                             dual_mesh,
+                                             lambda_h,
+                                             update_values | update_JxW_values |
+                                               (with_laplacians ?
+                                                  update_hessians :
+                                                  update_default));
       },
-      [&](const auto &cell, Scratch &scratch, NoCopy &) {
+      [&](const auto &cell, CellScratch &scratch, NoCopy &) {
         if (!cell->is_locally_owned())
           return;
         scratch.values.reinit(cell, ghosted_solution);
@@ -359,39 +372,6 @@ namespace membranes
 
 
 
-  /**
-   * What one thread needs on a cell for the flux estimator: u_ih, ∇u_ih,
-   * σ_ih, div σ_ih and λ̃_h at the quadrature points of the pieces
-   * K ∩ D_a.
-   */
-  template <int dim>
-  struct ErrorEstimator<dim>::FluxScratch
-  {
-    FluxScratch(const Discretization<dim> &discretization,
-                const DualMesh<dim>       &dual_mesh,
-                const VectorType          &lambda_h)
-      : values(discretization,
-               dual_mesh,
-               lambda_h,
-               update_values | update_gradients | update_jacobians |
-                 update_JxW_values)
-    {
-      for (unsigned int i = 0; i < 2; ++i)
-        {
-          u[i].resize(values.fe_values.n_quadrature_points);
-          grad_u[i].resize(values.fe_values.n_quadrature_points);
-        }
-    }
-
-    DualCellValues<dim>                        values;
-    std::array<std::vector<double>, 2>         u;
-    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
-    std::vector<Tensor<1, dim>>                flux;
-    std::vector<double>                        divergence, lambda;
-  };
-
-
-
   template <int dim>
   typename ErrorEstimator<dim>::FluxTerms &
   ErrorEstimator<dim>::FluxTerms::operator+=(const FluxTerms &other)
@@ -435,11 +415,14 @@ namespace membranes
     run_on_cells<FluxTerms>(
       dof_handler,
       [&]() {
-        return std::make_unique<FluxScratch>(discretization,
+        return std::make_unique<CellScratch>(discretization,
                                              dual_mesh,
-                                             lambda_h);
+                                             lambda_h,
+                                             update_values | update_gradients |
+                                               update_jacobians |
+                                               update_JxW_values);
       },
-      [&](const CellIterator &cell, FluxScratch &scratch, FluxTerms &terms) {
+      [&](const CellIterator &cell, CellScratch &scratch, FluxTerms &terms) {
         terms = FluxTerms();
         if (!cell->is_locally_owned())
           return;
@@ -470,7 +453,7 @@ namespace membranes
     const CellIterator           &cell,
     const BlockVectorType        &ghosted_solution,
     const FluxEquilibration<dim> &flux_equilibration,
-    FluxScratch                  &scratch) const
+    CellScratch                  &scratch) const
   {
     scratch.values.reinit(cell, ghosted_solution);
     const FEValues<dim> &fe_values = scratch.values.fe_values;

@@ -377,7 +377,8 @@ namespace membranes
             std::sqrt(squares[4] + squares[5]),
             std::sqrt(squares[4]),
             std::sqrt(data.mu[0] * std::pow(seminorm(0), 2) +
-                      data.mu[1] * std::pow(seminorm(1), 2))};
+                      data.mu[1] * std::pow(seminorm(1), 2)),
+            0.};
   }
 
 

@@ -153,6 +153,9 @@ namespace membranes
   private:
     using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
 
+    /** The values of one cell for both estimators (defined in the .cc). */
+    struct CellScratch;
+
     /** Element residuals, oscillation and the contact term. */
     void
     add_cell_terms(const DoFHandler<dim>      &dof_handler,
@@ -228,15 +231,13 @@ namespace membranes
       eta_squared() const;
     };
 
-    /** The values of one cell for flux_terms() (defined in the .cc). */
-    struct FluxScratch;
 
     /** The FluxTerms of one locally owned cell. */
     FluxTerms
     flux_terms(const CellIterator           &cell,
                const BlockVectorType        &ghosted_solution,
                const FluxEquilibration<dim> &flux_equilibration,
-               FluxScratch                  &scratch) const;
+               CellScratch                  &scratch) const;
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
