@@ -421,8 +421,6 @@ namespace membranes
   void
   MembraneProblem<dim>::output_results(const unsigned int cycle)
   {
-    if (!parameters.output.write_vtu && !parameters.output.write_nodal_values)
-      return;
     field_output.write(cycle,
                        dof_handler,
                        ghosted_solution,
@@ -550,41 +548,6 @@ namespace membranes
 
 
   /**
-   * The wall time of each phase of this cycle, from the sections of
-   * computing_timer: on several processes that of the slowest process (each
-   * phase ends in communication). The flux reconstruction has a time only
-   * where it was computed, the error norms only with an exact solution.
-   * (TimerOutput::print_wall_time_statistics() prints the minimum, mean and
-   * maximum over the processes to a stream; the report needs the maximum as
-   * a number in its row.)
-   */
-  template <int dim>
-  TimeRecord
-  MembraneProblem<dim>::phase_times() const
-  {
-    const std::map<std::string, double> times =
-      computing_timer.get_summary_data(TimerOutput::total_wall_time);
-    const auto time_of = [&](const std::string &section) {
-      const auto time = times.find(section);
-      return Utilities::MPI::max(time == times.end() ? 0. : time->second,
-                                 mpi_communicator);
-    };
-    TimeRecord phases;
-    phases.setup       = time_of("setup");
-    phases.assembly    = time_of("assembly");
-    phases.solve       = time_of("solve");
-    phases.postprocess = time_of("postprocess");
-    phases.estimate    = time_of("estimate");
-    if (computes_fluxes())
-      phases.flux = time_of("flux");
-    if (data.exact_solution_known())
-      phases.errors = time_of("errors");
-    return phases;
-  }
-
-
-
-  /**
    * Whether the estimator of `Refinement/Estimator` of this cycle is at
    * most `Refinement/Target estimator` (when one is set); says so.
    */
@@ -655,15 +618,36 @@ namespace membranes
 
 
   /**
-   * The costs of the cycle into its record (the times of its phases, the
-   * cumulative time of the run, the peak memory summed over the processes),
-   * and the last line of its progress output.
+   * The costs of the cycle into its record, and the last line of its
+   * progress output: the wall time of each phase, from the sections of
+   * computing_timer, on several processes that of the slowest process (each
+   * phase ends in communication; the flux reconstruction has a time only
+   * where it was computed, the error norms only with an exact solution;
+   * TimerOutput::print_wall_time_statistics() prints the minimum, mean and
+   * maximum over the processes to a stream, the report needs the maximum as
+   * a number in its row), the cumulative time of the run, and the peak
+   * memory summed over the processes.
    */
   template <int dim>
   void
   MembraneProblem<dim>::record_costs()
   {
-    record.times = phase_times();
+    const std::map<std::string, double> times =
+      computing_timer.get_summary_data(TimerOutput::total_wall_time);
+    const auto time_of = [&](const std::string &section) {
+      const auto time = times.find(section);
+      return Utilities::MPI::max(time == times.end() ? 0. : time->second,
+                                 mpi_communicator);
+    };
+    record.times.setup       = time_of("setup");
+    record.times.assembly    = time_of("assembly");
+    record.times.solve       = time_of("solve");
+    record.times.postprocess = time_of("postprocess");
+    record.times.estimate    = time_of("estimate");
+    if (computes_fluxes())
+      record.times.flux = time_of("flux");
+    if (data.exact_solution_known())
+      record.times.errors = time_of("errors");
     record.cumulative_wall_time =
       previous_record.cumulative_wall_time + record.times.method();
     Utilities::System::MemoryStats memory;

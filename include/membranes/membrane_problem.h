@@ -2,7 +2,6 @@
 #define membranes_membrane_problem_h
 
 #include <deal.II/base/conditional_ostream.h>
-#include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -105,8 +104,6 @@ namespace membranes
     target_reached() const;
     bool
     refine_grid();
-    TimeRecord
-    phase_times() const;
     bool
     exceeds_max_dofs(const unsigned int cycle) const;
     void

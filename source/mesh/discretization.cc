@@ -1,5 +1,4 @@
 #include <cmath>
-#include <deal.II/base/quadrature_lib.h>
 #include <deal.II/distributed/shared_tria.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>

@@ -2,9 +2,7 @@
 #include <array>
 #include <cmath>
 #include <deal.II/base/mpi.h>
-#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/numerics/data_out.h>
-#include <fstream>
 #include <iomanip>
 #include <map>
 #include <membranes/output/atomic_file.h>

@@ -56,15 +56,6 @@ namespace membranes
       return only_output;
     }
 
-    /** The text of the open file @p file, at most a line of it. */
-    std::string
-    contents(const int file)
-    {
-      char          text[200];
-      const ssize_t length = ::pread(file, text, sizeof(text) - 1, 0);
-      return length > 0 ? std::string(text, length) : "";
-    }
-
     /**
      * Create @p directory and its parents where missing; whether it was
      * missing. An InputError naming `Output/Directory` if it cannot be made.
@@ -227,8 +218,12 @@ namespace membranes
           throw file_error("open", lock_path, errno);
         if (::flock(file, LOCK_EX | LOCK_NB) != 0)
           {
-            const int         reason = errno;
-            const std::string holder = contents(file);
+            const int reason = errno;
+            // Who holds it, at most a line of text.
+            char              text[200];
+            const ssize_t     length = ::pread(file, text, sizeof(text) - 1, 0);
+            const std::string holder =
+              length > 0 ? std::string(text, length) : "";
             ::close(file);
             if (reason == EWOULDBLOCK)
               throw Parameters::InputError(

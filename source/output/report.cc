@@ -3,7 +3,6 @@
 #include <membranes/output/atomic_file.h>
 #include <membranes/output/report.h>
 #include <set>
-#include <sstream>
 
 namespace membranes
 {

@@ -2,7 +2,6 @@
 #define membranes_error_estimator_h
 
 #include <array>
-#include <deal.II/base/index_set.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
@@ -12,7 +11,6 @@
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/output/report.h>
-#include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
 
 namespace membranes

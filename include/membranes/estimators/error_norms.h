@@ -1,8 +1,6 @@
 #ifndef membranes_error_norms_h
 #define membranes_error_norms_h
 
-#include <array>
-#include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
