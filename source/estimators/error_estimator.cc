@@ -411,7 +411,8 @@ namespace membranes
     const MPI_Comm                mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    FluxTerms sums;
+    const std::array<double, 2> sign{{1., -1.}};
+    FluxTerms                   sums;
     run_on_cells<FluxTerms>(
       dof_handler,
       [&]() {
@@ -426,7 +427,44 @@ namespace membranes
         terms = FluxTerms();
         if (!cell->is_locally_owned())
           return;
-        terms = flux_terms(cell, ghosted_solution, flux_equilibration, scratch);
+        scratch.values.reinit(cell, ghosted_solution);
+        const FEValues<dim> &fe_values = scratch.values.fe_values;
+        // λ̃_h = Σ_a λ_a φ_a, the P1/Q1 function of the nodal values of λ_h.
+        scratch.lambda.resize(fe_values.n_quadrature_points);
+        fe_values.get_function_values(scratch.values.nodal_lambda_h,
+                                      scratch.lambda);
+        const double                     h_K = cell->diameter();
+        const FEValuesExtractors::Scalar scalar(0);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            fe_values[scalar].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.u[i]);
+            fe_values[scalar].get_function_gradients_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.grad_u[i]);
+            flux_equilibration.flux_values(
+              cell, i, fe_values, scratch.flux, scratch.divergence);
+            const auto load =
+              flux_equilibration.get_reconstruction().load_values(cell, i);
+            for (const unsigned int q : fe_values.quadrature_point_indices())
+              {
+                terms.flux[i] +=
+                  (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
+                    .norm_square() *
+                  fe_values.JxW(q);
+                terms.residual[i] +=
+                  std::pow(load[q] + sign[i] * scratch.lambda[q] -
+                             scratch.divergence[q],
+                           2) *
+                  fe_values.JxW(q);
+              }
+            terms.flux[i] /= data.mu[i];
+            terms.residual[i] *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
+          }
+        double contact = 0;
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
+                     fe_values.JxW(q);
+        terms.contact                         = std::max(contact, 0.);
         indicators[cell->active_cell_index()] = terms.eta_squared();
       },
       [&](const FluxTerms &terms) { sums += terms; });
@@ -443,59 +481,6 @@ namespace membranes
     estimate.boundary =
       boundary_data_part(dof_handler, ghosted_solution, mpi_communicator);
     return estimate;
-  }
-
-
-
-  template <int dim>
-  typename ErrorEstimator<dim>::FluxTerms
-  ErrorEstimator<dim>::flux_terms(
-    const CellIterator           &cell,
-    const BlockVectorType        &ghosted_solution,
-    const FluxEquilibration<dim> &flux_equilibration,
-    CellScratch                  &scratch) const
-  {
-    scratch.values.reinit(cell, ghosted_solution);
-    const FEValues<dim> &fe_values = scratch.values.fe_values;
-    // λ̃_h = Σ_a λ_a φ_a, the P1/Q1 function of the nodal values of λ_h.
-    scratch.lambda.resize(fe_values.n_quadrature_points);
-    fe_values.get_function_values(scratch.values.nodal_lambda_h,
-                                  scratch.lambda);
-    const std::array<double, 2>      sign{{1., -1.}};
-    const double                     h_K = cell->diameter();
-    const FEValuesExtractors::Scalar scalar(0);
-    FluxTerms                        terms;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        fe_values[scalar].get_function_values_from_local_dof_values(
-          scratch.values.local_dofs[i], scratch.u[i]);
-        fe_values[scalar].get_function_gradients_from_local_dof_values(
-          scratch.values.local_dofs[i], scratch.grad_u[i]);
-        flux_equilibration.flux_values(
-          cell, i, fe_values, scratch.flux, scratch.divergence);
-        const auto load =
-          flux_equilibration.get_reconstruction().load_values(cell, i);
-        for (const unsigned int q : fe_values.quadrature_point_indices())
-          {
-            terms.flux[i] +=
-              (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
-                .norm_square() *
-              fe_values.JxW(q);
-            terms.residual[i] +=
-              std::pow(load[q] + sign[i] * scratch.lambda[q] -
-                         scratch.divergence[q],
-                       2) *
-              fe_values.JxW(q);
-          }
-        terms.flux[i] /= data.mu[i];
-        terms.residual[i] *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
-      }
-    double contact = 0;
-    for (const unsigned int q : fe_values.quadrature_point_indices())
-      contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
-                 fe_values.JxW(q);
-    terms.contact = std::max(contact, 0.);
-    return terms;
   }
 
 

@@ -229,14 +229,6 @@ namespace membranes
       eta_squared() const;
     };
 
-
-    /** The FluxTerms of one locally owned cell. */
-    FluxTerms
-    flux_terms(const CellIterator           &cell,
-               const BlockVectorType        &ghosted_solution,
-               const FluxEquilibration<dim> &flux_equilibration,
-               CellScratch                  &scratch) const;
-
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;
   };
