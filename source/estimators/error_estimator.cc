@@ -373,33 +373,6 @@ namespace membranes
 
 
   template <int dim>
-  typename ErrorEstimator<dim>::FluxTerms &
-  ErrorEstimator<dim>::FluxTerms::operator+=(const FluxTerms &other)
-  {
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        flux[i] += other.flux[i];
-        residual[i] += other.residual[i];
-      }
-    contact += other.contact;
-    return *this;
-  }
-
-
-
-  template <int dim>
-  double
-  ErrorEstimator<dim>::FluxTerms::eta_squared() const
-  {
-    double eta2 = 0;
-    for (unsigned int i = 0; i < 2; ++i)
-      eta2 += std::pow(std::sqrt(flux[i]) + std::sqrt(residual[i]), 2);
-    return eta2 + 2 * contact;
-  }
-
-
-
-  template <int dim>
   FluxRecord
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>        &dof_handler,

@@ -2,6 +2,7 @@
 #define membranes_error_estimator_h
 
 #include <array>
+#include <cmath>
 #include <deal.II/base/tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
@@ -222,11 +223,26 @@ namespace membranes
       double                contact = 0;
 
       FluxTerms &
-      operator+=(const FluxTerms &other);
+      operator+=(const FluxTerms &other)
+      {
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            flux[i] += other.flux[i];
+            residual[i] += other.residual[i];
+          }
+        contact += other.contact;
+        return *this;
+      }
 
       /** Σ_i (η_F,i + η_R,i)² + 2 (λ̃_h, u1h − u2h)⁺. */
       double
-      eta_squared() const;
+      eta_squared() const
+      {
+        double eta2 = 0;
+        for (unsigned int i = 0; i < 2; ++i)
+          eta2 += std::pow(std::sqrt(flux[i]) + std::sqrt(residual[i]), 2);
+        return eta2 + 2 * contact;
+      }
     };
 
     const Discretization<dim> &discretization;
