@@ -140,7 +140,6 @@ namespace membranes
   };
 
 
-
   /**
    * The report of a run: report.csv with one row per cycle,
    * rewritten after every cycle by write_atomically() (a stopped run never
@@ -176,14 +175,7 @@ namespace membranes
     void
     print_convergence_table(const bool rates_in_dofs);
 
-    /** The column names of report.csv, in order. */
-    static const std::vector<std::string> &
-    column_names();
-
   private:
-    void
-    write_csv() const;
-
     const Parameters::Output &parameters;
     const ConditionalOStream &pcout;
     std::vector<CycleRecord>  records;
