@@ -71,31 +71,25 @@ namespace membranes
           const unsigned int n = order.size();
           for (unsigned int k = 0; k < n; ++k)
             {
-              const Point<dim> &a = cell->vertex(order[k]);
-              for (unsigned int d = 0; d < dim; ++d)
-                if (!(std::abs(a[d]) <= Parameters::max_magnitude))
-                  {
-                    std::ostringstream allowed;
-                    allowed << "vertex (" << a << ") of cell " << cell->index()
-                            << ": coordinates must be finite and at most "
-                            << Parameters::max_magnitude << " in magnitude";
-                    throw Parameters::invalid_entry("Geometry/Mesh file",
-                                                    file_name,
-                                                    allowed.str());
-                  }
+              const Point<dim>  &a = cell->vertex(order[k]);
+              std::ostringstream allowed;
+              if (!(std::abs(a[0]) <= Parameters::max_magnitude &&
+                    std::abs(a[1]) <= Parameters::max_magnitude))
+                allowed << "vertex (" << a << ") of cell " << cell->index()
+                        << ": coordinates must be finite and at most "
+                        << Parameters::max_magnitude << " in magnitude";
               const Tensor<1, dim> next = cell->vertex(order[(k + 1) % n]) - a;
               const Tensor<1, dim> previous =
                 cell->vertex(order[(k + n - 1) % n]) - a;
-              if (!(next[0] * previous[1] - next[1] * previous[0] > 0))
-                {
-                  std::ostringstream allowed;
-                  allowed << "cell " << cell->index() << " is degenerate, "
-                          << "inverted or self-intersecting at its vertex ("
-                          << a << ")";
-                  throw Parameters::invalid_entry("Geometry/Mesh file",
-                                                  file_name,
-                                                  allowed.str());
-                }
+              if (allowed.str().empty() &&
+                  !(next[0] * previous[1] - next[1] * previous[0] > 0))
+                allowed << "cell " << cell->index() << " is degenerate, "
+                        << "inverted or self-intersecting at its vertex (" << a
+                        << ")";
+              if (!allowed.str().empty())
+                throw Parameters::invalid_entry("Geometry/Mesh file",
+                                                file_name,
+                                                allowed.str());
             }
         }
     }
