@@ -187,7 +187,25 @@ namespace membranes
         {
           lock();
           remove_earlier_output();
-          write_provenance();
+          write_atomically(
+            directory + "/" + parameters_name, [this](std::ostream &out) {
+              out << "# The parameters of the run that wrote this "
+                     "directory (see run-info.txt);\n"
+                  << "# 'membranes parameters.prm' runs it again.\n"
+                  << provenance.parameters;
+            });
+          std::error_code   error;
+          const std::string working_directory =
+            fs::current_path(error).string();
+          write_atomically(
+            directory + "/" + run_info_name, [&](std::ostream &out) {
+              out << "version: " << MEMBRANES_VERSION << '\n'
+                  << "command: " << provenance.command_line << '\n'
+                  << "working directory: " << working_directory << '\n'
+                  << "processes: "
+                  << dealii::Utilities::MPI::n_mpi_processes(mpi_communicator)
+                  << '\n';
+            });
         }
       catch (const std::exception &error)
         {
@@ -289,28 +307,5 @@ namespace membranes
             error.path1().filename().string() + ": " + error.code().message() +
             ")");
       }
-  }
-
-
-
-  void
-  OutputDirectory::write_provenance() const
-  {
-    write_atomically(directory + "/" + parameters_name,
-                     [this](std::ostream &out) {
-                       out << "# The parameters of the run that wrote this "
-                              "directory (see run-info.txt);\n"
-                           << "# 'membranes parameters.prm' runs it again.\n"
-                           << provenance.parameters;
-                     });
-    std::error_code   error;
-    const std::string working_directory = fs::current_path(error).string();
-    write_atomically(directory + "/" + run_info_name, [&](std::ostream &out) {
-      out << "version: " << MEMBRANES_VERSION << '\n'
-          << "command: " << provenance.command_line << '\n'
-          << "working directory: " << working_directory << '\n'
-          << "processes: "
-          << dealii::Utilities::MPI::n_mpi_processes(mpi_communicator) << '\n';
-    });
   }
 } // namespace membranes

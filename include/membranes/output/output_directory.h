@@ -108,10 +108,6 @@ namespace membranes
     void
     remove_earlier_output() const;
 
-    /** parameters.prm and run-info.txt. */
-    void
-    write_provenance() const;
-
     const std::string directory;
     const Provenance  provenance;
     const MPI_Comm    mpi_communicator;
