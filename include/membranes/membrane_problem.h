@@ -143,8 +143,7 @@ namespace membranes
     BlockVectorType solution;
     BlockVectorType ghosted_solution;
     /** λ_a at every vertex a of V_h (ghosted; DiscreteAction::lambda_h()). */
-    VectorType lambda_h;
-    /** The active vertices. */
+    VectorType     lambda_h;
     ActiveSet<dim> active_set;
     /** η_K² of the estimator that drives refinement, by active cell index. */
     Vector<double> indicators;

@@ -422,8 +422,8 @@ namespace membranes
       },
       [&](const FluxTerms &terms) { sums += terms; });
 
-    Utilities::MPI::sum(sums.flux, mpi_communicator, sums.flux);
-    Utilities::MPI::sum(sums.residual, mpi_communicator, sums.residual);
+    Utilities::MPI::sum<double>(sums.flux, mpi_communicator, sums.flux);
+    Utilities::MPI::sum<double>(sums.residual, mpi_communicator, sums.residual);
     sums.contact = Utilities::MPI::sum(sums.contact, mpi_communicator);
 
     FluxRecord estimate;

@@ -359,7 +359,7 @@ namespace membranes
           squares[k] += cell_squares[k];
       });
 
-    Utilities::MPI::sum(squares, mpi_communicator, squares);
+    Utilities::MPI::sum<double>(squares, mpi_communicator, squares);
     const auto seminorm = [&](const unsigned int i) {
       return std::sqrt(squares[i]);
     };
