@@ -17,7 +17,6 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/multithread_info.h>
 #include <deal.II/base/parameter_handler.h>
-#include <deal.II/base/utilities.h>
 #include <filesystem>
 #include <iostream>
 #include <membranes/membrane_problem.h>
