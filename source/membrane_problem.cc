@@ -595,9 +595,9 @@ namespace membranes
 
 
   /**
-   * The mesh of the cycle into its record, and the first line of its
-   * progress output. The DoFs are those of the pair (u1h, u2h): both
-   * blocks of the solution.
+   * The mesh of the cycle and the number of processes into its record, and
+   * the first line of its progress output. The DoFs are those of the pair
+   * (u1h, u2h): both blocks of the solution.
    */
   template <int dim>
   void
@@ -609,9 +609,9 @@ namespace membranes
                    static_cast<types::global_dof_index>(solution.size())};
     pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
           << record.mesh.dofs << " DoFs";
-    if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
-      pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
-            << " processes";
+    record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
+    if (record.processes > 1)
+      pcout << " on " << record.processes << " processes";
     pcout << std::endl;
   }
 
@@ -652,7 +652,6 @@ namespace membranes
       previous_record.cumulative_wall_time + record.times.method();
     Utilities::System::MemoryStats memory;
     Utilities::System::get_memory_stats(memory);
-    record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
     record.memory_mb =
       Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
     pcout << "   " << record.solve.active_set_iterations

@@ -86,12 +86,12 @@ namespace membranes
                                       const VectorType           &lambda_h,
                                       Vector<double> &indicators) const
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a. The Laplacian of u_ih vanishes on
     // triangles (P1) and on axis-parallel rectangles (Q1: a bilinear
     // function has no ∂²/∂x², ∂²/∂y²), not on other quadrilaterals.
     const bool with_laplacians =
-      !fe.reference_cell().is_simplex() && !discretization.rectangles();
+      !discretization.fe->reference_cell().is_simplex() &&
+      !discretization.rectangles();
     const std::array<double, 2> sign{{1., -1.}};
 
     // Each cell adds to its own indicator only: nothing to copy.
@@ -254,11 +254,10 @@ namespace membranes
     const DoFHandler<dim> &dof_handler,
     const BlockVectorType &ghosted_solution) const
   {
-    const FiniteElement<dim>                  &fe = *discretization.fe;
     std::vector<std::array<Tensor<1, dim>, 2>> cell_gradients(
       dof_handler.get_triangulation().n_active_cells());
     FEValues<dim>               fe_values(*discretization.mapping,
-                            fe,
+                            *discretization.fe,
                             QGaussSimplex<dim>(1),
                             update_gradients);
     std::vector<Tensor<1, dim>> gradient(1);

@@ -79,8 +79,7 @@ namespace membranes
     data_out.add_data_vector(fields.active_set, "active_set", nodal);
     const auto   &triangulation = dof_handler.get_triangulation();
     Vector<float> subdomain(triangulation.n_active_cells());
-    for (float &value : subdomain)
-      value = triangulation.locally_owned_subdomain();
+    subdomain = triangulation.locally_owned_subdomain();
     data_out.add_data_vector(subdomain,
                              "subdomain",
                              DataOut<dim>::type_cell_data);
