@@ -363,17 +363,15 @@ namespace membranes
     const auto seminorm = [&](const unsigned int i) {
       return std::sqrt(squares[i]);
     };
-    const auto l2 = [&](const unsigned int i) {
-      return std::sqrt(squares[2 + i]);
-    };
     // The full H1 norm of (3.5) from the seminorm and the L2 norm.
     const auto full_norm = [&](const unsigned int i) {
-      return std::sqrt(std::pow(seminorm(i), 2) + std::pow(l2(i), 2));
+      return std::sqrt(std::pow(seminorm(i), 2) +
+                       std::pow(std::sqrt(squares[2 + i]), 2));
     };
     return {full_norm(0),
             full_norm(1),
-            l2(0),
-            l2(1),
+            std::sqrt(squares[2]),
+            std::sqrt(squares[3]),
             std::sqrt(squares[4] + squares[5]),
             std::sqrt(squares[4]),
             std::sqrt(data.mu[0] * std::pow(seminorm(0), 2) +

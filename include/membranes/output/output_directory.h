@@ -78,9 +78,8 @@ namespace membranes
     create_subdirectory(const std::string &name) const;
 
     /**
-     * Create and lock the directory, remove the output of an earlier run,
-     * write the records of this one; a Parameters::CollectiveError if the
-     * directory is in use or any of this fails.
+     * Claim the directory as the class documentation says; a
+     * Parameters::CollectiveError if it is in use or any step fails.
      */
     void
     claim();
