@@ -17,7 +17,6 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/multithread_info.h>
 #include <deal.II/base/parameter_handler.h>
-#include <deal.II/base/utilities.h>
 #include <filesystem>
 #include <iostream>
 #include <membranes/membrane_problem.h>
@@ -104,17 +103,12 @@ namespace
     for (int i = 1; i < argc; ++i)
       {
         const std::string arg = argv[i];
-        if (arg == "-h" || arg == "--help")
-          {
-            arguments.help = true;
-            return arguments;
-          }
-        else if (arg == "-p" || arg == "--print-parameters")
-          {
-            arguments.print_parameters = true;
-            return arguments;
-          }
-        else if (arg == "-s" || arg == "--set")
+        arguments.help        = (arg == "-h" || arg == "--help");
+        arguments.print_parameters =
+          (arg == "-p" || arg == "--print-parameters");
+        if (arguments.help || arguments.print_parameters)
+          return arguments;
+        if (arg == "-s" || arg == "--set")
           {
             if (i + 1 == argc)
               throw membranes::Parameters::InputError(arg +

@@ -269,7 +269,7 @@ namespace membranes
     if (!data.exact_solution_known())
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
-    const auto         errors =
+    ErrorRecord        errors =
       ErrorNorms<dim>(discretization,
                       data,
                       parameters.exact_solution.reference_quadrature)
@@ -277,24 +277,10 @@ namespace membranes
           dof_handler, ghosted_solution, dual_mesh, lambda_h, mpi_communicator);
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
     // (benchmarks/README.md, "The H^-1 norm of the action").
-    const double lambda_Hm1 =
+    errors.lambda_Hm1 =
       NegativeNorm<dim>(discretization)
         .lambda_error(dof_handler, dual_mesh, lambda_h, data, mpi_communicator);
-    // The full H1 norm of (3.5) from the seminorm and the L2 norm.
-    const auto full_norm = [&](const unsigned int i) {
-      return std::sqrt(std::pow(errors.u_H1_seminorm[i], 2) +
-                       std::pow(errors.u_L2[i], 2));
-    };
-    return ErrorRecord{full_norm(0),
-                       full_norm(1),
-                       errors.u_L2[0],
-                       errors.u_L2[1],
-                       errors.lambda_L2,
-                       errors.lambda_L2_omega_h,
-                       std::sqrt(
-                         data.mu[0] * std::pow(errors.u_H1_seminorm[0], 2) +
-                         data.mu[1] * std::pow(errors.u_H1_seminorm[1], 2)),
-                       lambda_Hm1};
+    return errors;
   }
 
 
@@ -372,7 +358,15 @@ namespace membranes
       hanging_node_constraints,
       discrete_problem.locally_owned_dofs(),
       mpi_communicator);
-    FluxRecord flux;
+    Vector<double> flux_indicators;
+    FluxRecord     flux = ErrorEstimator<dim>(discretization, data)
+                        .flux_estimate(dof_handler,
+                                       ghosted_solution,
+                                       dual_mesh,
+                                       lambda_h,
+                                       *flux_equilibration,
+                                       flux_indicators,
+                                       mpi_communicator);
     if (parameters.output.flux_reconstruction)
       {
         const auto identities = flux_reconstruction->identities(
@@ -381,21 +375,6 @@ namespace membranes
         flux.conservation_defect = identities.conservation_defect;
         flux.balance_defect      = identities.balance_defect;
       }
-
-    Vector<double> flux_indicators;
-    const auto     estimate = ErrorEstimator<dim>(discretization, data)
-                            .flux_estimate(dof_handler,
-                                           ghosted_solution,
-                                           dual_mesh,
-                                           lambda_h,
-                                           *flux_equilibration,
-                                           flux_indicators,
-                                           mpi_communicator);
-    flux.estimator   = estimate.eta;
-    flux.flux        = estimate.flux;
-    flux.oscillation = estimate.oscillation;
-    flux.contact     = estimate.contact;
-    flux.boundary    = estimate.boundary;
     if (parameters.refinement.estimator == Parameters::Estimator::flux)
       indicators.swap(flux_indicators);
     return flux;
@@ -442,8 +421,6 @@ namespace membranes
   void
   MembraneProblem<dim>::output_results(const unsigned int cycle)
   {
-    if (!parameters.output.write_vtu && !parameters.output.write_nodal_values)
-      return;
     field_output.write(cycle,
                        dof_handler,
                        ghosted_solution,
@@ -571,41 +548,6 @@ namespace membranes
 
 
   /**
-   * The wall time of each phase of this cycle, from the sections of
-   * computing_timer: on several processes that of the slowest process (each
-   * phase ends in communication). The flux reconstruction has a time only
-   * where it was computed, the error norms only with an exact solution.
-   * (TimerOutput::print_wall_time_statistics() prints the minimum, mean and
-   * maximum over the processes to a stream; the report needs the maximum as
-   * a number in its row.)
-   */
-  template <int dim>
-  TimeRecord
-  MembraneProblem<dim>::phase_times() const
-  {
-    const std::map<std::string, double> times =
-      computing_timer.get_summary_data(TimerOutput::total_wall_time);
-    const auto time_of = [&](const std::string &section) {
-      const auto time = times.find(section);
-      return Utilities::MPI::max(time == times.end() ? 0. : time->second,
-                                 mpi_communicator);
-    };
-    TimeRecord phases;
-    phases.setup       = time_of("setup");
-    phases.assembly    = time_of("assembly");
-    phases.solve       = time_of("solve");
-    phases.postprocess = time_of("postprocess");
-    phases.estimate    = time_of("estimate");
-    if (computes_fluxes())
-      phases.flux = time_of("flux");
-    if (data.exact_solution_known())
-      phases.errors = time_of("errors");
-    return phases;
-  }
-
-
-
-  /**
    * Whether the estimator of `Refinement/Estimator` of this cycle is at
    * most `Refinement/Target estimator` (when one is set); says so.
    */
@@ -653,9 +595,9 @@ namespace membranes
 
 
   /**
-   * The mesh of the cycle into its record, and the first line of its
-   * progress output. The DoFs are those of the pair (u1h, u2h): both
-   * blocks of the solution.
+   * The mesh of the cycle and the number of processes into its record, and
+   * the first line of its progress output. The DoFs are those of the pair
+   * (u1h, u2h): both blocks of the solution.
    */
   template <int dim>
   void
@@ -667,29 +609,49 @@ namespace membranes
                    static_cast<types::global_dof_index>(solution.size())};
     pcout << "Cycle " << cycle << ": " << record.mesh.cells << " cells, "
           << record.mesh.dofs << " DoFs";
-    if (Utilities::MPI::n_mpi_processes(mpi_communicator) > 1)
-      pcout << " on " << Utilities::MPI::n_mpi_processes(mpi_communicator)
-            << " processes";
+    record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
+    if (record.processes > 1)
+      pcout << " on " << record.processes << " processes";
     pcout << std::endl;
   }
 
 
 
   /**
-   * The costs of the cycle into its record (the times of its phases, the
-   * cumulative time of the run, the peak memory summed over the processes),
-   * and the last line of its progress output.
+   * The costs of the cycle into its record, and the last line of its
+   * progress output: the wall time of each phase, from the sections of
+   * computing_timer, on several processes that of the slowest process (each
+   * phase ends in communication; the flux reconstruction has a time only
+   * where it was computed, the error norms only with an exact solution;
+   * TimerOutput::print_wall_time_statistics() prints the minimum, mean and
+   * maximum over the processes to a stream, the report needs the maximum as
+   * a number in its row), the cumulative time of the run, and the peak
+   * memory summed over the processes.
    */
   template <int dim>
   void
   MembraneProblem<dim>::record_costs()
   {
-    record.times = phase_times();
+    const std::map<std::string, double> times =
+      computing_timer.get_summary_data(TimerOutput::total_wall_time);
+    const auto time_of = [&](const std::string &section) {
+      const auto time = times.find(section);
+      return Utilities::MPI::max(time == times.end() ? 0. : time->second,
+                                 mpi_communicator);
+    };
+    record.times.setup       = time_of("setup");
+    record.times.assembly    = time_of("assembly");
+    record.times.solve       = time_of("solve");
+    record.times.postprocess = time_of("postprocess");
+    record.times.estimate    = time_of("estimate");
+    if (computes_fluxes())
+      record.times.flux = time_of("flux");
+    if (data.exact_solution_known())
+      record.times.errors = time_of("errors");
     record.cumulative_wall_time =
       previous_record.cumulative_wall_time + record.times.method();
     Utilities::System::MemoryStats memory;
     Utilities::System::get_memory_stats(memory);
-    record.processes = Utilities::MPI::n_mpi_processes(mpi_communicator);
     record.memory_mb =
       Utilities::MPI::sum(memory.VmHWM / 1024., mpi_communicator);
     pcout << "   " << record.solve.active_set_iterations

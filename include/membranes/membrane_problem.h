@@ -2,7 +2,6 @@
 #define membranes_membrane_problem_h
 
 #include <deal.II/base/conditional_ostream.h>
-#include <deal.II/base/index_set.h>
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/dofs/dof_handler.h>
@@ -105,8 +104,6 @@ namespace membranes
     target_reached() const;
     bool
     refine_grid();
-    TimeRecord
-    phase_times() const;
     bool
     exceeds_max_dofs(const unsigned int cycle) const;
     void
@@ -146,8 +143,7 @@ namespace membranes
     BlockVectorType solution;
     BlockVectorType ghosted_solution;
     /** λ_a at every vertex a of V_h (ghosted; DiscreteAction::lambda_h()). */
-    VectorType lambda_h;
-    /** The active vertices. */
+    VectorType     lambda_h;
     ActiveSet<dim> active_set;
     /** η_K² of the estimator that drives refinement, by active cell index. */
     Vector<double> indicators;

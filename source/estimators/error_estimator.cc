@@ -46,6 +46,37 @@ namespace membranes
 
 
 
+  /**
+   * What one thread needs on a cell: u_ih, ∇u_ih, Δu_ih (zero unless
+   * computed), σ_ih, div σ_ih and λ̃_h at the quadrature points of the
+   * pieces K ∩ D_a.
+   */
+  template <int dim>
+  struct ErrorEstimator<dim>::CellScratch
+  {
+    CellScratch(const Discretization<dim> &discretization,
+                const DualMesh<dim>       &dual_mesh,
+                const VectorType          &lambda_h,
+                const UpdateFlags          flags)
+      : values(discretization, dual_mesh, lambda_h, flags)
+    {
+      for (unsigned int i = 0; i < 2; ++i)
+        {
+          u[i].resize(values.fe_values.n_quadrature_points);
+          grad_u[i].resize(values.fe_values.n_quadrature_points);
+          laplacian[i].assign(values.fe_values.n_quadrature_points, 0.0);
+        }
+    }
+
+    DualCellValues<dim>                        values;
+    std::array<std::vector<double>, 2>         u, laplacian;
+    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
+    std::vector<Tensor<1, dim>>                flux;
+    std::vector<double>                        divergence, lambda;
+  };
+
+
+
   template <int dim>
   void
   ErrorEstimator<dim>::add_cell_terms(const DoFHandler<dim> &dof_handler,
@@ -55,33 +86,12 @@ namespace membranes
                                       const VectorType           &lambda_h,
                                       Vector<double> &indicators) const
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
     // λ_h and u_h on the pieces K ∩ D_a. The Laplacian of u_ih vanishes on
     // triangles (P1) and on axis-parallel rectangles (Q1: a bilinear
     // function has no ∂²/∂x², ∂²/∂y²), not on other quadrilaterals.
     const bool with_laplacians =
-      !fe.reference_cell().is_simplex() && !discretization.rectangles();
-    struct Scratch
-    {
-      Scratch(const Discretization<dim> &discretization,
-              const DualMesh<dim>       &dual_mesh,
-              const VectorType          &lambda_h,
-              const bool                 with_laplacians)
-        : values(discretization,
-                 dual_mesh,
-                 lambda_h,
-                 update_values | update_JxW_values |
-                   (with_laplacians ? update_hessians : update_default))
-      {
-        for (unsigned int i = 0; i < 2; ++i)
-          {
-            u[i].resize(values.fe_values.n_quadrature_points);
-            laplacian[i].assign(values.fe_values.n_quadrature_points, 0.0);
-          }
-      }
-      DualCellValues<dim>                values;
-      std::array<std::vector<double>, 2> u, laplacian;
-    };
+      !discretization.fe->reference_cell().is_simplex() &&
+      !discretization.rectangles();
     const std::array<double, 2> sign{{1., -1.}};
 
     // Each cell adds to its own indicator only: nothing to copy.
@@ -90,12 +100,15 @@ namespace membranes
     run_on_cells<NoCopy>(
       dof_handler,
       [&]() {
-        return std::make_unique<Scratch>(discretization,
-                                         dual_mesh,
-                                         lambda_h,
-                                         with_laplacians);
+        return std::make_unique<CellScratch>(discretization,
+                                             dual_mesh,
+                                             lambda_h,
+                                             update_values | update_JxW_values |
+                                               (with_laplacians ?
+                                                  update_hessians :
+                                                  update_default));
       },
-      [&](const auto &cell, Scratch &scratch, NoCopy &) {
+      [&](const auto &cell, CellScratch &scratch, NoCopy &) {
         if (!cell->is_locally_owned())
           return;
         scratch.values.reinit(cell, ghosted_solution);
@@ -143,8 +156,7 @@ namespace membranes
   /**
    * What one thread needs on an edge between quadrilaterals: the two traces
    * of the gradient of each membrane on the edge, with matching points,
-   * from the nodal values of the cell (side 0) and of its neighbour
-   * (side 1).
+   * on the cell (side 0) and on its neighbour (side 1).
    */
   template <int dim>
   struct ErrorEstimator<dim>::JumpScratch
@@ -152,9 +164,6 @@ namespace membranes
     JumpScratch(const Discretization<dim> &discretization)
     {
       const FiniteElement<dim> &fe = *discretization.fe;
-      for (auto &membrane_values : local_dofs)
-        for (auto &values : membrane_values)
-          values.resize(fe.n_dofs_per_cell());
       if (!fe.reference_cell().is_simplex())
         interface_values =
           std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
@@ -168,8 +177,6 @@ namespace membranes
     std::unique_ptr<FEInterfaceValues<dim>> interface_values;
     /** traces[i][side]: ∇u_ih at the points of the edge. */
     std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
-    /** local_dofs[i][side]: the nodal values of u_ih on that cell. */
-    std::array<std::array<std::vector<double>, 2>, 2> local_dofs;
   };
 
 
@@ -247,27 +254,21 @@ namespace membranes
     const DoFHandler<dim> &dof_handler,
     const BlockVectorType &ghosted_solution) const
   {
-    const FiniteElement<dim>                  &fe = *discretization.fe;
     std::vector<std::array<Tensor<1, dim>, 2>> cell_gradients(
       dof_handler.get_triangulation().n_active_cells());
     FEValues<dim>               fe_values(*discretization.mapping,
-                            fe,
+                            *discretization.fe,
                             QGaussSimplex<dim>(1),
                             update_gradients);
     std::vector<Tensor<1, dim>> gradient(1);
-    std::vector<double>         local_dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
           for (unsigned int i = 0; i < 2; ++i)
             {
-              cell->get_dof_values(ghosted_solution.block(i),
-                                   local_dofs.begin(),
-                                   local_dofs.end());
-              fe_values[FEValuesExtractors::Scalar(0)]
-                .get_function_gradients_from_local_dof_values(local_dofs,
-                                                              gradient);
+              fe_values.get_function_gradients(ghosted_solution.block(i),
+                                               gradient);
               cell_gradients[cell->active_cell_index()][i] = gradient[0];
             }
         }
@@ -332,21 +333,12 @@ namespace membranes
     std::array<double, 2> integrals{};
     for (unsigned int i = 0; i < 2; ++i)
       {
-        auto &traces     = scratch.traces[i];
-        auto &local_dofs = scratch.local_dofs[i];
-        cell->get_dof_values(ghosted_solution.block(i),
-                             local_dofs[0].begin(),
-                             local_dofs[0].end());
-        neighbor->get_dof_values(ghosted_solution.block(i),
-                                 local_dofs[1].begin(),
-                                 local_dofs[1].end());
+        auto &traces = scratch.traces[i];
         for (unsigned int side = 0; side < 2; ++side)
           {
             traces[side].resize(n_q);
-            interface_values
-              .get_fe_face_values(side)[FEValuesExtractors::Scalar(0)]
-              .get_function_gradients_from_local_dof_values(local_dofs[side],
-                                                            traces[side]);
+            interface_values.get_fe_face_values(side).get_function_gradients(
+              ghosted_solution.block(i), traces[side]);
           }
         for (unsigned int q = 0; q < n_q; ++q)
           integrals[i] += std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
@@ -359,68 +351,8 @@ namespace membranes
 
 
 
-  /**
-   * What one thread needs on a cell for the flux estimator: u_ih, ∇u_ih,
-   * σ_ih, div σ_ih and λ̃_h at the quadrature points of the pieces
-   * K ∩ D_a.
-   */
   template <int dim>
-  struct ErrorEstimator<dim>::FluxScratch
-  {
-    FluxScratch(const Discretization<dim> &discretization,
-                const DualMesh<dim>       &dual_mesh,
-                const VectorType          &lambda_h)
-      : values(discretization,
-               dual_mesh,
-               lambda_h,
-               update_values | update_gradients | update_jacobians |
-                 update_JxW_values)
-    {
-      for (unsigned int i = 0; i < 2; ++i)
-        {
-          u[i].resize(values.fe_values.n_quadrature_points);
-          grad_u[i].resize(values.fe_values.n_quadrature_points);
-        }
-    }
-
-    DualCellValues<dim>                        values;
-    std::array<std::vector<double>, 2>         u;
-    std::array<std::vector<Tensor<1, dim>>, 2> grad_u;
-    std::vector<Tensor<1, dim>>                flux;
-    std::vector<double>                        divergence, lambda;
-  };
-
-
-
-  template <int dim>
-  typename ErrorEstimator<dim>::FluxTerms &
-  ErrorEstimator<dim>::FluxTerms::operator+=(const FluxTerms &other)
-  {
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        flux[i] += other.flux[i];
-        residual[i] += other.residual[i];
-      }
-    contact += other.contact;
-    return *this;
-  }
-
-
-
-  template <int dim>
-  double
-  ErrorEstimator<dim>::FluxTerms::eta_squared() const
-  {
-    double eta2 = 0;
-    for (unsigned int i = 0; i < 2; ++i)
-      eta2 += std::pow(std::sqrt(flux[i]) + std::sqrt(residual[i]), 2);
-    return eta2 + 2 * contact;
-  }
-
-
-
-  template <int dim>
-  typename ErrorEstimator<dim>::FluxEstimate
+  FluxRecord
   ErrorEstimator<dim>::flux_estimate(
     const DoFHandler<dim>        &dof_handler,
     const BlockVectorType        &ghosted_solution,
@@ -431,33 +363,70 @@ namespace membranes
     const MPI_Comm                mpi_communicator) const
   {
     indicators.reinit(dof_handler.get_triangulation().n_active_cells());
-    FluxTerms sums;
+    const std::array<double, 2> sign{{1., -1.}};
+    FluxTerms                   sums;
     run_on_cells<FluxTerms>(
       dof_handler,
       [&]() {
-        return std::make_unique<FluxScratch>(discretization,
+        return std::make_unique<CellScratch>(discretization,
                                              dual_mesh,
-                                             lambda_h);
+                                             lambda_h,
+                                             update_values | update_gradients |
+                                               update_jacobians |
+                                               update_JxW_values);
       },
-      [&](const CellIterator &cell, FluxScratch &scratch, FluxTerms &terms) {
+      [&](const CellIterator &cell, CellScratch &scratch, FluxTerms &terms) {
         terms = FluxTerms();
         if (!cell->is_locally_owned())
           return;
-        terms = flux_terms(cell, ghosted_solution, flux_equilibration, scratch);
+        scratch.values.reinit(cell, ghosted_solution);
+        const FEValues<dim> &fe_values = scratch.values.fe_values;
+        // λ̃_h = Σ_a λ_a φ_a, the P1/Q1 function of the nodal values of λ_h.
+        scratch.lambda.resize(fe_values.n_quadrature_points);
+        fe_values.get_function_values(scratch.values.nodal_lambda_h,
+                                      scratch.lambda);
+        const double                     h_K = cell->diameter();
+        const FEValuesExtractors::Scalar scalar(0);
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            fe_values[scalar].get_function_values_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.u[i]);
+            fe_values[scalar].get_function_gradients_from_local_dof_values(
+              scratch.values.local_dofs[i], scratch.grad_u[i]);
+            flux_equilibration.flux_values(
+              cell, i, fe_values, scratch.flux, scratch.divergence);
+            const auto load =
+              flux_equilibration.get_reconstruction().load_values(cell, i);
+            for (const unsigned int q : fe_values.quadrature_point_indices())
+              {
+                terms.flux[i] +=
+                  (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
+                    .norm_square() *
+                  fe_values.JxW(q);
+                terms.residual[i] +=
+                  std::pow(load[q] + sign[i] * scratch.lambda[q] -
+                             scratch.divergence[q],
+                           2) *
+                  fe_values.JxW(q);
+              }
+            terms.flux[i] /= data.mu[i];
+            terms.residual[i] *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
+          }
+        double contact = 0;
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
+                     fe_values.JxW(q);
+        terms.contact                         = std::max(contact, 0.);
         indicators[cell->active_cell_index()] = terms.eta_squared();
       },
       [&](const FluxTerms &terms) { sums += terms; });
 
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        sums.flux[i] = Utilities::MPI::sum(sums.flux[i], mpi_communicator);
-        sums.residual[i] =
-          Utilities::MPI::sum(sums.residual[i], mpi_communicator);
-      }
+    Utilities::MPI::sum<double>(sums.flux, mpi_communicator, sums.flux);
+    Utilities::MPI::sum<double>(sums.residual, mpi_communicator, sums.residual);
     sums.contact = Utilities::MPI::sum(sums.contact, mpi_communicator);
 
-    FluxEstimate estimate;
-    estimate.eta         = std::sqrt(sums.eta_squared());
+    FluxRecord estimate;
+    estimate.estimator   = std::sqrt(sums.eta_squared());
     estimate.flux        = std::sqrt(sums.flux[0] + sums.flux[1]);
     estimate.oscillation = std::sqrt(sums.residual[0] + sums.residual[1]);
     estimate.contact     = std::sqrt(2 * sums.contact);
@@ -469,72 +438,16 @@ namespace membranes
 
 
   template <int dim>
-  typename ErrorEstimator<dim>::FluxTerms
-  ErrorEstimator<dim>::flux_terms(
-    const CellIterator           &cell,
-    const BlockVectorType        &ghosted_solution,
-    const FluxEquilibration<dim> &flux_equilibration,
-    FluxScratch                  &scratch) const
-  {
-    scratch.values.reinit(cell, ghosted_solution);
-    const FEValues<dim> &fe_values = scratch.values.fe_values;
-    // λ̃_h = Σ_a λ_a φ_a, the P1/Q1 function of the nodal values of λ_h.
-    scratch.lambda.resize(fe_values.n_quadrature_points);
-    fe_values.get_function_values(scratch.values.nodal_lambda_h,
-                                  scratch.lambda);
-    const std::array<double, 2>      sign{{1., -1.}};
-    const double                     h_K = cell->diameter();
-    const FEValuesExtractors::Scalar scalar(0);
-    FluxTerms                        terms;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        fe_values[scalar].get_function_values_from_local_dof_values(
-          scratch.values.local_dofs[i], scratch.u[i]);
-        fe_values[scalar].get_function_gradients_from_local_dof_values(
-          scratch.values.local_dofs[i], scratch.grad_u[i]);
-        flux_equilibration.flux_values(
-          cell, i, fe_values, scratch.flux, scratch.divergence);
-        const auto load =
-          flux_equilibration.get_reconstruction().load_values(cell, i);
-        for (const unsigned int q : fe_values.quadrature_point_indices())
-          {
-            terms.flux[i] +=
-              (data.mu[i] * scratch.grad_u[i][q] + scratch.flux[q])
-                .norm_square() *
-              fe_values.JxW(q);
-            terms.residual[i] +=
-              std::pow(load[q] + sign[i] * scratch.lambda[q] -
-                         scratch.divergence[q],
-                       2) *
-              fe_values.JxW(q);
-          }
-        terms.flux[i] /= data.mu[i];
-        terms.residual[i] *= std::pow(h_K / numbers::PI, 2) / data.mu[i];
-      }
-    double contact = 0;
-    for (const unsigned int q : fe_values.quadrature_point_indices())
-      contact += scratch.lambda[q] * (scratch.u[0][q] - scratch.u[1][q]) *
-                 fe_values.JxW(q);
-    terms.contact = std::max(contact, 0.);
-    return terms;
-  }
-
-
-
-  template <int dim>
   double
   ErrorEstimator<dim>::boundary_data_part(
     const DoFHandler<dim> &dof_handler,
     const BlockVectorType &ghosted_solution,
     const MPI_Comm         mpi_communicator) const
   {
-    const FiniteElement<dim> &fe = *discretization.fe;
-    const Quadrature<dim - 1> quadrature =
-      fe.reference_cell().is_simplex() ?
-        Quadrature<dim - 1>(QGaussSimplex<dim - 1>(3)) :
-        Quadrature<dim - 1>(QGauss<dim - 1>(3));
-    FEFaceValues<dim> face_values(*discretization.mapping,
-                                  fe,
+    // An edge is a line on triangles too: QGaussSimplex<1> is QGauss<1>.
+    const QGauss<dim - 1> quadrature(3);
+    FEFaceValues<dim>     face_values(*discretization.mapping,
+                                  *discretization.fe,
                                   quadrature,
                                   update_values | update_quadrature_points |
                                     update_JxW_values);

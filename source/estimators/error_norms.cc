@@ -282,7 +282,7 @@ namespace membranes
 
 
   template <int dim>
-  typename ErrorNorms<dim>::Errors
+  ErrorRecord
   ErrorNorms<dim>::compute(const DoFHandler<dim> &dof_handler,
                            const BlockVectorType &ghosted_solution,
                            const DualMesh<dim>   &dual_mesh,
@@ -359,12 +359,24 @@ namespace membranes
           squares[k] += cell_squares[k];
       });
 
-    for (double &square : squares)
-      square = Utilities::MPI::sum(square, mpi_communicator);
-    return {{{std::sqrt(squares[0]), std::sqrt(squares[1])}},
-            {{std::sqrt(squares[2]), std::sqrt(squares[3])}},
+    Utilities::MPI::sum<double>(squares, mpi_communicator, squares);
+    const auto seminorm = [&](const unsigned int i) {
+      return std::sqrt(squares[i]);
+    };
+    // The full H1 norm of (3.5) from the seminorm and the L2 norm.
+    const auto full_norm = [&](const unsigned int i) {
+      return std::sqrt(std::pow(seminorm(i), 2) +
+                       std::pow(std::sqrt(squares[2 + i]), 2));
+    };
+    return {full_norm(0),
+            full_norm(1),
+            std::sqrt(squares[2]),
+            std::sqrt(squares[3]),
             std::sqrt(squares[4] + squares[5]),
-            std::sqrt(squares[4])};
+            std::sqrt(squares[4]),
+            std::sqrt(data.mu[0] * std::pow(seminorm(0), 2) +
+                      data.mu[1] * std::pow(seminorm(1), 2)),
+            0.};
   }
 
 

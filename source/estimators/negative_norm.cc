@@ -21,30 +21,6 @@ namespace membranes
 {
   namespace
   {
-    template <int dim>
-    std::unique_ptr<FiniteElement<dim>>
-    riesz_element(const Parameters::CellType cell_type,
-                  const unsigned int         degree)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<FE_SimplexP<dim>>(degree);
-      return std::make_unique<FE_Q<dim>>(degree);
-    }
-
-
-
-    template <int dim>
-    Quadrature<dim>
-    riesz_cell_quadrature(const Parameters::CellType cell_type,
-                          const unsigned int         degree)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return QGaussSimplex<dim>(degree + 1);
-      return QGauss<dim>(degree + 1);
-    }
-
-
-
     /** What one thread of the assembly of NegativeNorm works with. */
     template <int dim>
     struct RieszScratch
@@ -81,9 +57,12 @@ namespace membranes
                                   const unsigned int         degree,
                                   const unsigned int         jump_subdivisions)
     : discretization(discretization)
-    , fe(riesz_element<dim>(discretization.cell_type, degree))
+    , fe(discretization.cell_type == Parameters::CellType::triangle ?
+           std::unique_ptr<FiniteElement<dim>>(new FE_SimplexP<dim>(degree)) :
+           std::make_unique<FE_Q<dim>>(degree))
     , cell_quadrature(
-        riesz_cell_quadrature<dim>(discretization.cell_type, degree))
+        fe->reference_cell().template get_gauss_type_quadrature<dim>(degree +
+                                                                     1))
     , density_quadrature(fe->reference_cell(), 2)
     , jump_quadrature(fe->reference_cell(),
                       QIteratedSimplex<dim>(QGaussSimplex<dim>(2),

@@ -29,7 +29,20 @@ namespace membranes
   CellSystem<dim>::reinit(
     const typename DoFHandler<dim>::active_cell_iterator &cell)
   {
-    reinit_operator(cell);
+    fe_values.reinit(cell);
+    cell->get_dof_indices(dof_indices);
+    laplace_matrix = 0;
+    lumped_mass    = 0;
+    for (const unsigned int q : fe_values.quadrature_point_indices())
+      for (const unsigned int v : fe_values.dof_indices())
+        {
+          for (const unsigned int w : fe_values.dof_indices())
+            laplace_matrix(v, w) += fe_values.shape_grad(v, q) *
+                                    fe_values.shape_grad(w, q) *
+                                    fe_values.JxW(q);
+          lumped_mass(v) += fe_values.shape_value(v, q) * fe_values.JxW(q);
+        }
+
     data.load_list(fe_values.get_quadrature_points(), load_values);
     for (unsigned int i = 0; i < 2; ++i)
       {
@@ -50,40 +63,6 @@ namespace membranes
           load_oscillation[i] +=
             std::pow(f[q] - load_mean[i], 2) * fe_values.JxW(q);
       }
-  }
-
-
-
-  template <int dim>
-  void
-  CellSystem<dim>::reinit_operator(
-    const typename DoFHandler<dim>::active_cell_iterator &cell)
-  {
-    fe_values.reinit(cell);
-    cell->get_dof_indices(dof_indices);
-
-    laplace_matrix = 0;
-    lumped_mass    = 0;
-    for (const unsigned int q : fe_values.quadrature_point_indices())
-      for (const unsigned int v : fe_values.dof_indices())
-        {
-          for (const unsigned int w : fe_values.dof_indices())
-            laplace_matrix(v, w) += fe_values.shape_grad(v, q) *
-                                    fe_values.shape_grad(w, q) *
-                                    fe_values.JxW(q);
-          lumped_mass(v) += fe_values.shape_value(v, q) * fe_values.JxW(q);
-        }
-  }
-
-
-
-  template <int dim>
-  void
-  CellSystem<dim>::set_loads(const double *cell_loads)
-  {
-    for (auto &load : loads)
-      for (unsigned int v = 0; v < load.size(); ++v)
-        load(v) = *cell_loads++;
   }
 
 

@@ -1,12 +1,9 @@
 #include <cmath>
-#include <deal.II/base/quadrature_lib.h>
 #include <deal.II/distributed/shared_tria.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/fe/fe_q.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/mapping_cartesian.h>
-#include <deal.II/fe/mapping_fe.h>
-#include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_generator.h>
 #include <deal.II/grid/grid_in.h>
 #include <deal.II/grid/grid_tools.h>
@@ -19,35 +16,6 @@ namespace membranes
 {
   namespace
   {
-    template <int dim>
-    std::unique_ptr<FiniteElement<dim>>
-    make_fe(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<FE_SimplexP<dim>>(1);
-      return std::make_unique<FE_Q<dim>>(1);
-    }
-
-    template <int dim>
-    std::unique_ptr<Mapping<dim>>
-    make_mapping(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return std::make_unique<MappingFE<dim>>(FE_SimplexP<dim>(1));
-      return std::make_unique<MappingQ1<dim>>();
-    }
-
-    template <int dim>
-    Quadrature<dim>
-    make_cell_quadrature(const Parameters::CellType cell_type)
-    {
-      if (cell_type == Parameters::CellType::triangle)
-        return QGaussSimplex<dim>(3);
-      return QGauss<dim>(3);
-    }
-
-
-
     /**
      * A Gmsh file announces how many nodes and elements follow, and
      * GridIn allocates that much before it reads them: reject a count that
@@ -103,31 +71,25 @@ namespace membranes
           const unsigned int n = order.size();
           for (unsigned int k = 0; k < n; ++k)
             {
-              const Point<dim> &a = cell->vertex(order[k]);
-              for (unsigned int d = 0; d < dim; ++d)
-                if (!(std::abs(a[d]) <= Parameters::max_magnitude))
-                  {
-                    std::ostringstream allowed;
-                    allowed << "vertex (" << a << ") of cell " << cell->index()
-                            << ": coordinates must be finite and at most "
-                            << Parameters::max_magnitude << " in magnitude";
-                    throw Parameters::invalid_entry("Geometry/Mesh file",
-                                                    file_name,
-                                                    allowed.str());
-                  }
+              const Point<dim>  &a = cell->vertex(order[k]);
+              std::ostringstream allowed;
+              if (!(std::abs(a[0]) <= Parameters::max_magnitude &&
+                    std::abs(a[1]) <= Parameters::max_magnitude))
+                allowed << "vertex (" << a << ") of cell " << cell->index()
+                        << ": coordinates must be finite and at most "
+                        << Parameters::max_magnitude << " in magnitude";
               const Tensor<1, dim> next = cell->vertex(order[(k + 1) % n]) - a;
               const Tensor<1, dim> previous =
                 cell->vertex(order[(k + n - 1) % n]) - a;
-              if (!(next[0] * previous[1] - next[1] * previous[0] > 0))
-                {
-                  std::ostringstream allowed;
-                  allowed << "cell " << cell->index() << " is degenerate, "
-                          << "inverted or self-intersecting at its vertex ("
-                          << a << ")";
-                  throw Parameters::invalid_entry("Geometry/Mesh file",
-                                                  file_name,
-                                                  allowed.str());
-                }
+              if (allowed.str().empty() &&
+                  !(next[0] * previous[1] - next[1] * previous[0] > 0))
+                allowed << "cell " << cell->index() << " is degenerate, "
+                        << "inverted or self-intersecting at its vertex (" << a
+                        << ")";
+              if (!allowed.str().empty())
+                throw Parameters::invalid_entry("Geometry/Mesh file",
+                                                file_name,
+                                                allowed.str());
             }
         }
     }
@@ -178,9 +140,13 @@ namespace membranes
   template <int dim>
   Discretization<dim>::Discretization(const Parameters::CellType cell_type)
     : cell_type(cell_type)
-    , fe(make_fe<dim>(cell_type))
-    , mapping(make_mapping<dim>(cell_type))
-    , cell_quadrature(make_cell_quadrature<dim>(cell_type))
+    , fe(cell_type == Parameters::CellType::triangle ?
+           std::unique_ptr<FiniteElement<dim>>(new FE_SimplexP<dim>(1)) :
+           std::make_unique<FE_Q<dim>>(1))
+    , mapping(
+        fe->reference_cell().template get_default_linear_mapping<dim>().clone())
+    , cell_quadrature(
+        fe->reference_cell().template get_gauss_type_quadrature<dim>(3))
     , dual_cell_quadrature(fe->reference_cell(), 2)
   {}
 

@@ -2,9 +2,7 @@
 #include <array>
 #include <cmath>
 #include <deal.II/base/mpi.h>
-#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/numerics/data_out.h>
-#include <fstream>
 #include <iomanip>
 #include <map>
 #include <membranes/output/atomic_file.h>
@@ -35,25 +33,6 @@ namespace membranes
     std::vector<std::string> files;
     if (!parameters.write_vtu && !parameters.write_nodal_values)
       return files;
-    const Fields fields =
-      make_fields(dof_handler, ghosted_solution, active_vertices);
-    if (parameters.write_vtu)
-      files.push_back(write_vtu(
-        cycle, dof_handler, ghosted_solution, lambda_h, fields, indicators));
-    if (parameters.write_nodal_values)
-      files.push_back(write_nodal_values(
-        cycle, dof_handler, ghosted_solution, lambda_h, fields));
-    return files;
-  }
-
-
-
-  template <int dim>
-  typename FieldOutput<dim>::Fields
-  FieldOutput<dim>::make_fields(const DoFHandler<dim> &dof_handler,
-                                const BlockVectorType &ghosted_solution,
-                                const IndexSet        &active_vertices) const
-  {
     const IndexSet &owned_dofs = dof_handler.locally_owned_dofs();
     VectorType      w(owned_dofs, mpi_communicator);
     for (const types::global_dof_index dof : owned_dofs)
@@ -65,12 +44,16 @@ namespace membranes
     active_set.compress(VectorOperation::insert);
 
     // Ghosted, in the layout of the blocks of the solution.
-    Fields fields;
-    fields.w.reinit(ghosted_solution.block(0), true);
-    fields.active_set.reinit(ghosted_solution.block(0), true);
+    Fields fields{ghosted_solution.block(0), ghosted_solution.block(0)};
     fields.w          = w;
     fields.active_set = active_set;
-    return fields;
+    if (parameters.write_vtu)
+      files.push_back(write_vtu(
+        cycle, dof_handler, ghosted_solution, lambda_h, fields, indicators));
+    if (parameters.write_nodal_values)
+      files.push_back(write_nodal_values(
+        cycle, dof_handler, ghosted_solution, lambda_h, fields));
+    return files;
   }
 
 
@@ -96,8 +79,7 @@ namespace membranes
     data_out.add_data_vector(fields.active_set, "active_set", nodal);
     const auto   &triangulation = dof_handler.get_triangulation();
     Vector<float> subdomain(triangulation.n_active_cells());
-    for (float &value : subdomain)
-      value = triangulation.locally_owned_subdomain();
+    subdomain = triangulation.locally_owned_subdomain();
     data_out.add_data_vector(subdomain,
                              "subdomain",
                              DataOut<dim>::type_cell_data);

@@ -56,32 +56,24 @@ namespace membranes
       return only_output;
     }
 
-    /** The text of the open file @p file, at most a line of it. */
-    std::string
-    contents(const int file)
+    /**
+     * Create @p directory and its parents where missing; whether it was
+     * missing. An InputError naming `Output/Directory` if it cannot be made.
+     */
+    bool
+    create_directory(const std::string &directory)
     {
-      char          text[200];
-      const ssize_t length = ::pread(file, text, sizeof(text) - 1, 0);
-      return length > 0 ? std::string(text, length) : "";
+      std::error_code error;
+      const bool      created = fs::create_directories(directory, error);
+      if (error || !fs::is_directory(directory))
+        throw Parameters::invalid_entry(
+          "Output/Directory",
+          directory,
+          "cannot create this directory (" +
+            (error ? error.message() : "a file of that name exists") + ")");
+      return created;
     }
   } // namespace
-
-
-
-  bool
-  create_directory(const std::string &directory)
-  {
-    std::error_code error;
-    const bool      created = fs::create_directories(directory, error);
-    if (error || !fs::is_directory(directory))
-      throw Parameters::invalid_entry("Output/Directory",
-                                      directory,
-                                      "cannot create this directory (" +
-                                        (error ? error.message() :
-                                                 "a file of that name exists") +
-                                        ")");
-    return created;
-  }
 
 
 
@@ -195,7 +187,25 @@ namespace membranes
         {
           lock();
           remove_earlier_output();
-          write_provenance();
+          write_atomically(
+            directory + "/" + parameters_name, [this](std::ostream &out) {
+              out << "# The parameters of the run that wrote this "
+                     "directory (see run-info.txt);\n"
+                  << "# 'membranes parameters.prm' runs it again.\n"
+                  << provenance.parameters;
+            });
+          std::error_code   error;
+          const std::string working_directory =
+            fs::current_path(error).string();
+          write_atomically(
+            directory + "/" + run_info_name, [&](std::ostream &out) {
+              out << "version: " << MEMBRANES_VERSION << '\n'
+                  << "command: " << provenance.command_line << '\n'
+                  << "working directory: " << working_directory << '\n'
+                  << "processes: "
+                  << dealii::Utilities::MPI::n_mpi_processes(mpi_communicator)
+                  << '\n';
+            });
         }
       catch (const std::exception &error)
         {
@@ -226,8 +236,12 @@ namespace membranes
           throw file_error("open", lock_path, errno);
         if (::flock(file, LOCK_EX | LOCK_NB) != 0)
           {
-            const int         reason = errno;
-            const std::string holder = contents(file);
+            const int reason = errno;
+            // Who holds it, at most a line of text.
+            char              text[200];
+            const ssize_t     length = ::pread(file, text, sizeof(text) - 1, 0);
+            const std::string holder =
+              length > 0 ? std::string(text, length) : "";
             ::close(file);
             if (reason == EWOULDBLOCK)
               throw Parameters::InputError(
@@ -293,28 +307,5 @@ namespace membranes
             error.path1().filename().string() + ": " + error.code().message() +
             ")");
       }
-  }
-
-
-
-  void
-  OutputDirectory::write_provenance() const
-  {
-    write_atomically(directory + "/" + parameters_name,
-                     [this](std::ostream &out) {
-                       out << "# The parameters of the run that wrote this "
-                              "directory (see run-info.txt);\n"
-                           << "# 'membranes parameters.prm' runs it again.\n"
-                           << provenance.parameters;
-                     });
-    std::error_code   error;
-    const std::string working_directory = fs::current_path(error).string();
-    write_atomically(directory + "/" + run_info_name, [&](std::ostream &out) {
-      out << "version: " << MEMBRANES_VERSION << '\n'
-          << "command: " << provenance.command_line << '\n'
-          << "working directory: " << working_directory << '\n'
-          << "processes: "
-          << dealii::Utilities::MPI::n_mpi_processes(mpi_communicator) << '\n';
-    });
   }
 } // namespace membranes

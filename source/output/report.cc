@@ -3,7 +3,6 @@
 #include <membranes/output/atomic_file.h>
 #include <membranes/output/report.h>
 #include <set>
-#include <sstream>
 
 namespace membranes
 {
@@ -97,20 +96,6 @@ namespace membranes
 
 
 
-  const std::vector<std::string> &
-  Report::column_names()
-  {
-    static const std::vector<std::string> names = [] {
-      std::vector<std::string> names;
-      for (const Field &field : row(CycleRecord()))
-        names.push_back(field.name);
-      return names;
-    }();
-    return names;
-  }
-
-
-
   Report::Report(const Parameters::Output &parameters,
                  const ConditionalOStream &pcout)
     : parameters(parameters)
@@ -123,20 +108,13 @@ namespace membranes
   Report::add(const CycleRecord &record)
   {
     records.push_back(record);
-    if (parameters.report && pcout.is_active())
-      write_csv();
-  }
-
-
-
-  void
-  Report::write_csv() const
-  {
+    if (!parameters.report || !pcout.is_active())
+      return;
     write_atomically(parameters.directory + "/report.csv",
                      [this](std::ostream &out) {
-                       const auto &names = column_names();
+                       const auto names = row(CycleRecord());
                        for (unsigned int c = 0; c < names.size(); ++c)
-                         out << (c == 0 ? "" : ",") << names[c];
+                         out << (c == 0 ? "" : ",") << names[c].name;
                        out << '\n' << std::setprecision(12);
                        for (const CycleRecord &record : records)
                          {

@@ -2,7 +2,7 @@
 #define membranes_error_estimator_h
 
 #include <array>
-#include <deal.II/base/index_set.h>
+#include <cmath>
 #include <deal.II/base/tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
@@ -11,7 +11,7 @@
 #include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
-#include <membranes/scene/parameters.h>
+#include <membranes/output/report.h>
 #include <membranes/scene/problem_data.h>
 
 namespace membranes
@@ -52,8 +52,6 @@ namespace membranes
    * vertices but not in between; it is the contact term of the estimators
    * of Part 2 of the paper and of Dabaghi, Martin and Vohralík for this
    * problem, there with equilibrated fluxes instead of residuals.
-   * The result drives adaptive refinement; η/|||e||| is reported as the
-   * effectivity index when the exact solution is known.
    *
    * The edge jumps are computed with FEInterfaceValues on quadrilaterals
    * (Q1: the normal derivative varies along an edge); on triangles (P1,
@@ -118,28 +116,6 @@ namespace membranes
     using VectorType      = TrilinosWrappers::MPI::Vector;
     using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
 
-    /**
-     * The flux estimator η and its parts, over all processes: η² =
-     * Σ_i (η_F,i + η_R,i)² + 2 B.
-     */
-    struct FluxEstimate
-    {
-      double eta = 0;
-      /** (Σ_i η_F,i²)^{1/2}: the distance of σ_ih from −μ_i ∇u_ih. */
-      double flux = 0;
-      /** (Σ_i η_R,i²)^{1/2}: the residual f_i + s_i λ̃_h − div σ_ih. */
-      double oscillation = 0;
-      /** (2 B)^{1/2}: the contact term. */
-      double contact = 0;
-      /**
-       * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
-       * g_2 = g2: the size of the energy of a lifting of the boundary
-       * data error into the cells along ∂ω (constant 1), which the
-       * argument for η assumes to vanish. Not part of η.
-       */
-      double boundary = 0;
-    };
-
     ErrorEstimator(const Discretization<dim> &discretization,
                    const ProblemData<dim>    &data);
 
@@ -161,9 +137,10 @@ namespace membranes
 
     /**
      * The flux estimator: the same with the equilibrated fluxes of
-     * @p flux_equilibration and the nodal λ_a of @p lambda_h.
+     * @p flux_equilibration and the nodal λ_a of @p lambda_h; η and its
+     * parts, over all processes, in the FluxRecord (its defects empty).
      */
-    FluxEstimate
+    FluxRecord
     flux_estimate(const DoFHandler<dim>        &dof_handler,
                   const BlockVectorType        &ghosted_solution,
                   const DualMesh<dim>          &dual_mesh,
@@ -175,6 +152,9 @@ namespace membranes
   private:
     using CellIterator = typename DoFHandler<dim>::active_cell_iterator;
 
+    /** The values of one cell for both estimators (defined in the .cc). */
+    struct CellScratch;
+
     /** Element residuals, oscillation and the contact term. */
     void
     add_cell_terms(const DoFHandler<dim>      &dof_handler,
@@ -184,7 +164,12 @@ namespace membranes
                    const VectorType           &lambda_h,
                    Vector<double>             &indicators) const;
 
-    /** The boundary data part of FluxEstimate. */
+    /**
+     * (Σ_i μ_i Σ_{e ⊂ ∂ω_h} h_e^{-1} ‖g_i − u_ih‖²_e)^{1/2}, g_1 = g,
+     * g_2 = g2: the size of the energy of a lifting of the boundary data
+     * error into the cells along ∂ω (constant 1), which the argument for η
+     * assumes to vanish. Not part of η.
+     */
     double
     boundary_data_part(const DoFHandler<dim> &dof_handler,
                        const BlockVectorType &ghosted_solution,
@@ -238,22 +223,27 @@ namespace membranes
       double                contact = 0;
 
       FluxTerms &
-      operator+=(const FluxTerms &other);
+      operator+=(const FluxTerms &other)
+      {
+        for (unsigned int i = 0; i < 2; ++i)
+          {
+            flux[i] += other.flux[i];
+            residual[i] += other.residual[i];
+          }
+        contact += other.contact;
+        return *this;
+      }
 
       /** Σ_i (η_F,i + η_R,i)² + 2 (λ̃_h, u1h − u2h)⁺. */
       double
-      eta_squared() const;
+      eta_squared() const
+      {
+        double eta2 = 0;
+        for (unsigned int i = 0; i < 2; ++i)
+          eta2 += std::pow(std::sqrt(flux[i]) + std::sqrt(residual[i]), 2);
+        return eta2 + 2 * contact;
+      }
     };
-
-    /** The values of one cell for flux_terms() (defined in the .cc). */
-    struct FluxScratch;
-
-    /** The FluxTerms of one locally owned cell. */
-    FluxTerms
-    flux_terms(const CellIterator           &cell,
-               const BlockVectorType        &ghosted_solution,
-               const FluxEquilibration<dim> &flux_equilibration,
-               FluxScratch                  &scratch) const;
 
     const Discretization<dim> &discretization;
     const ProblemData<dim>    &data;

@@ -1,18 +1,27 @@
 #ifndef membranes_error_norms_h
 #define membranes_error_norms_h
 
-#include <array>
-#include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discretization.h>
+#include <membranes/output/report.h>
 #include <membranes/scene/problem_data.h>
 
 namespace membranes
 {
   using namespace dealii;
+
+  /**
+   * Where the exact λ jumps: the cells on which λ (or λ − λ_h) varies by
+   * more than this share of max |λ_h|. A smooth λ varies across a cell by
+   * O(h), a jump by its height. The error norms of λ (ErrorNorms,
+   * NegativeNorm) integrate these cells by finer rules.
+   */
+  constexpr double lambda_jump_fraction = 0.1;
+
+
 
   /**
    * Errors against a known exact solution:
@@ -57,13 +66,6 @@ namespace membranes
    * of the exact solution per norm and membrane (benchmarks/README.md,
    * "Error norms in one pass").
    */
-  /**
-   * Where the exact λ jumps: the cells on which λ (or λ − λ_h) varies by
-   * more than this share of max |λ_h|. A smooth λ varies across a cell by
-   * O(h), a jump by its height. The error norms of λ (ErrorNorms,
-   * NegativeNorm) integrate these cells by finer rules.
-   */
-  constexpr double lambda_jump_fraction = 0.1;
 
 
 
@@ -73,14 +75,6 @@ namespace membranes
   public:
     using VectorType      = TrilinosWrappers::MPI::Vector;
     using BlockVectorType = TrilinosWrappers::MPI::BlockVector;
-
-    struct Errors
-    {
-      std::array<double, 2> u_H1_seminorm; ///< |u_i − u_ih|_{H1(ω)}.
-      std::array<double, 2> u_L2;          ///< ‖u_i − u_ih‖_{L2(ω)}.
-      double                lambda_L2;     ///< ‖λ − λ_h‖_{L2(ω)}.
-      double lambda_L2_omega_h;            ///< ‖λ − λ_h‖_{L2(ω_h)}.
-    };
 
     /**
      * With @p reference_levels > 0, every error is integrated instead by
@@ -95,9 +89,9 @@ namespace membranes
     /**
      * The errors of @p ghosted_solution (the blocks u1h, u2h, ghosted), with
      * @p lambda_h (DiscreteAction::lambda_h()) read on the dual cells of
-     * @p dual_mesh.
+     * @p dual_mesh; all of ErrorRecord but lambda_Hm1 (NegativeNorm's).
      */
-    Errors
+    ErrorRecord
     compute(const DoFHandler<dim> &dof_handler,
             const BlockVectorType &ghosted_solution,
             const DualMesh<dim>   &dual_mesh,

@@ -41,21 +41,6 @@ namespace membranes
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell);
 
-    /**
-     * The same without the loads (`loads` are left as they are):
-     * what does not evaluate the data, for a right-hand side whose loads
-     * were computed once per mesh.
-     */
-    void
-    reinit_operator(const typename DoFHandler<dim>::active_cell_iterator &cell);
-
-    /**
-     * Set `loads` from @p cell_loads: F_1K, then F_2K, as
-     * copy_loads() writes them.
-     */
-    void
-    set_loads(const double *cell_loads);
-
     /** The number of entries that copy_loads() writes: 2 n_v + 4. */
     unsigned int
     n_load_entries() const;

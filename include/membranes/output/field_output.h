@@ -89,12 +89,6 @@ namespace membranes
       VectorType w, active_set;
     };
 
-    /** The Fields of the arguments of write(). */
-    Fields
-    make_fields(const DoFHandler<dim> &dof_handler,
-                const BlockVectorType &ghosted_solution,
-                const IndexSet        &active_vertices) const;
-
     /**
      * Write this process's piece of @p name of cycle @p cycle with
      * @p write_piece; on N > 1 processes, the first one writes the .pvtu

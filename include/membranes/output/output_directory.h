@@ -16,13 +16,6 @@ namespace membranes
   };
 
   /**
-   * Create @p directory and its parents where missing; whether it was
-   * missing. An InputError naming `Output/Directory` if it cannot be made.
-   */
-  bool
-  create_directory(const std::string &directory);
-
-  /**
    * `Output/Directory`, held by one run for its whole life, so that the
    * directory holds the results of that run only, and says how they were
    * made.
@@ -85,9 +78,8 @@ namespace membranes
     create_subdirectory(const std::string &name) const;
 
     /**
-     * Create and lock the directory, remove the output of an earlier run,
-     * write the records of this one; a Parameters::CollectiveError if the
-     * directory is in use or any of this fails.
+     * Claim the directory as the class documentation says; a
+     * Parameters::CollectiveError if it is in use or any step fails.
      */
     void
     claim();
@@ -114,10 +106,6 @@ namespace membranes
      */
     void
     remove_earlier_output() const;
-
-    /** parameters.prm and run-info.txt. */
-    void
-    write_provenance() const;
 
     const std::string directory;
     const Provenance  provenance;

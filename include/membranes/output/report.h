@@ -77,7 +77,7 @@ namespace membranes
   struct FluxRecord
   {
     /**
-     * The flux estimator and its parts (ErrorEstimator::FluxEstimate): the
+     * The flux estimator and its parts (ErrorEstimator::flux_estimate()): the
      * flux part (Σ_i η_F,i²)^{1/2}, the oscillation part (Σ_i η_R,i²)^{1/2}
      * and the contact part (2 B)^{1/2}; the boundary data part, not part of
      * the estimator.
@@ -140,7 +140,6 @@ namespace membranes
   };
 
 
-
   /**
    * The report of a run: report.csv with one row per cycle,
    * rewritten after every cycle by write_atomically() (a stopped run never
@@ -176,14 +175,7 @@ namespace membranes
     void
     print_convergence_table(const bool rates_in_dofs);
 
-    /** The column names of report.csv, in order. */
-    static const std::vector<std::string> &
-    column_names();
-
   private:
-    void
-    write_csv() const;
-
     const Parameters::Output &parameters;
     const ConditionalOStream &pcout;
     std::vector<CycleRecord>  records;
