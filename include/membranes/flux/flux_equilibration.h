@@ -214,7 +214,6 @@ namespace membranes
     void
     add_patch_result(const CellIterator &cell, const double *result);
 
-    /** The rotations around the vertices of S_h (see the .cc file). */
     struct Rotations;
 
     /** The rotations around the vertices of S_h (see the .cc file). */

@@ -24,15 +24,9 @@ namespace membranes
    */
   struct PatchRecord
   {
-    /**
-     * The global DoF index of the vertex a of the patch (the same in both
-     * blocks).
-     */
+    /** The global DoF index of the vertex a of the patch (in both blocks). */
     types::global_dof_index vertex;
-    /**
-     * The key of the unknown flux through edge 2 of κ: the global DoF
-     * indices of the ends of its half-edge (see FluxReconstruction::EdgeKey).
-     */
+    /** The FluxReconstruction::EdgeKey of the flux through edge 2 of κ. */
     std::array<types::global_dof_index, 2> key;
     /** Outward flux of κ through edge 2 = factor × the unknown. */
     double factor;
