@@ -10,7 +10,6 @@
 
 namespace membranes
 {
-  /** The work arrays of one thread of solve_patches(). */
   template <int dim>
   struct FluxEquilibration<dim>::PatchScratch
   {
@@ -41,24 +40,6 @@ namespace membranes
 
 
   template <int dim>
-  FluxEquilibration<dim>::FluxEquilibration(
-    const FluxReconstruction<dim> &reconstruction)
-    : reconstruction(reconstruction)
-    , basis(reconstruction.sub_triangle_basis())
-  {}
-
-
-
-  template <int dim>
-  const FluxReconstruction<dim> &
-  FluxEquilibration<dim>::get_reconstruction() const
-  {
-    return reconstruction;
-  }
-
-
-
-  template <int dim>
   void
   FluxEquilibration<dim>::flux_values(const CellIterator          &cell,
                                       const unsigned int           i,
@@ -78,7 +59,7 @@ namespace membranes
         const unsigned int   s  = dual_cell_quadrature.sub_triangle_of_point(q);
         const unsigned int   id = cell->active_cell_index() * n_triangles + s;
         const auto          &f  = sigma[id][i];
-        const Tensor<2, dim> DF = jacobian_matrix(fe_values.jacobian(q));
+        const Tensor<2, dim> DF = fe_values.jacobian(q);
         const double         det = std::abs(determinant(DF));
         Tensor<1, dim>       reference =
           basis.reference_flux(s, f, quadrature.point(q));
@@ -110,6 +91,7 @@ namespace membranes
         const auto       &kappa = reconstruction.sub_triangles()[id];
         const PatchTerms &terms = patch_terms[id];
 
+        *record             = PatchRecord{};
         record->vertex      = a;
         record->key         = terms.key;
         record->factor      = terms.factor;
@@ -118,11 +100,6 @@ namespace membranes
           for (unsigned int l = k; l < 3; ++l, ++n)
             record->gram[n] = kappa.gram[k][l];
         record->area = kappa.area;
-
-        record->residual      = {};
-        record->mass          = 0;
-        record->boundary_mass = 0;
-        record->edge_flux     = {};
         for (unsigned int v = 0; v < n_vertices; ++v)
           if (coefficients[v] != 0)
             {
@@ -201,39 +178,21 @@ namespace membranes
     std::vector<PatchMember> members;
     members.reserve(dof_handler.get_triangulation().n_active_cells() *
                     GeometryInfo<dim>::vertices_per_cell);
-    // The condensed hat functions of one cell, by increasing a: at most two
-    // parents for each vertex.
-    std::vector<std::pair<types::global_dof_index, HatCoefficients>> of_cell;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          of_cell.clear();
-          const auto add = [&](const types::global_dof_index a,
-                               const unsigned int            v,
-                               const double                  weight) {
-            auto entry =
-              std::find_if(of_cell.begin(), of_cell.end(), [a](const auto &e) {
-                return e.first == a;
-              });
-            if (entry == of_cell.end())
-              entry = of_cell.insert(of_cell.end(), {a, HatCoefficients{}});
-            entry->second[v] += weight;
-          };
+          // The condensed hat functions of the cell, by increasing a.
+          std::map<types::global_dof_index, HatCoefficients> of_cell;
           for (const unsigned int v : cell->vertex_indices())
             {
               const auto dof = cell->vertex_dof_index(v, 0);
               if (const auto *entries =
                     hanging_node_constraints.get_constraint_entries(dof))
                 for (const auto &[parent, weight] : *entries)
-                  add(parent, v, weight);
+                  of_cell[parent][v] += weight;
               else
-                add(dof, v, 1);
+                of_cell[dof][v] += 1;
             }
-          std::sort(of_cell.begin(),
-                    of_cell.end(),
-                    [](const auto &p, const auto &q) {
-                      return p.first < q.first;
-                    });
           for (const auto &[a, coefficients] : of_cell)
             members.push_back({a, cell, coefficients});
         }
@@ -250,15 +209,11 @@ namespace membranes
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator) const
   {
-    const unsigned int                   n_ring = basis.ring().size();
-    std::vector<types::global_dof_index> remote_vertices;
+    const unsigned int n_ring = basis.ring().size();
+    IndexSet           remote_set(locally_owned_dofs.size());
     for (const PatchMember &member : remote_members)
-      remote_vertices.push_back(member.a);
-    std::sort(remote_vertices.begin(), remote_vertices.end());
-    IndexSet remote_set(locally_owned_dofs.size());
-    remote_set.add_indices(remote_vertices.begin(),
-                           std::unique(remote_vertices.begin(),
-                                       remote_vertices.end()));
+      remote_set.add_index(member.a);
+    remote_set.compress();
     const std::vector<unsigned int> owners =
       Utilities::MPI::compute_index_owner(locally_owned_dofs,
                                           remote_set,
@@ -302,6 +257,7 @@ namespace membranes
     // one of patch_starts to the next. The patch problems run on threads,
     // and σ_ih = Σ_a σ_ih^a on the owned cells is added by the copier in
     // the order of the patches.
+    const unsigned int        n_ring = basis.ring().size();
     std::vector<unsigned int> patch_starts;
     for (unsigned int k = 0; k < local_members.size(); ++k)
       if (k == 0 || local_members[k].a != local_members[k - 1].a)
@@ -310,72 +266,49 @@ namespace membranes
     run_in_order<PatchCopy>(
       patch_starts.cbegin(),
       patch_starts.cend() - 1,
-      [&]() { return std::make_unique<PatchScratch>(basis.ring().size()); },
+      [&]() { return std::make_unique<PatchScratch>(n_ring); },
       [&](const std::vector<unsigned int>::const_iterator &start,
           PatchScratch                                    &scratch,
           PatchCopy                                       &copy) {
-        solve_patch(start[0],
-                    start[1],
-                    local_members,
-                    patch_terms,
-                    lambda_h,
-                    remote,
-                    scratch,
-                    copy);
+        const unsigned int first = start[0], n_cells = start[1] - first;
+        const unsigned int result_size  = 6 * n_ring;
+        const types::global_dof_index a = local_members[first].a;
+        copy.first                      = first;
+        copy.n_cells                    = n_cells;
+        scratch.records.resize(n_cells * n_ring);
+        copy.results.assign(n_cells * result_size, 0.);
+        scratch.patch.clear();
+        scratch.result.clear();
+        for (unsigned int c = 0; c < n_cells; ++c)
+          {
+            const PatchMember &member = local_members[first + c];
+            write_patch_record(member.cell,
+                               a,
+                               member.coefficients,
+                               patch_terms,
+                               scratch.records.data() + c * n_ring);
+            scratch.patch.push_back(scratch.records.data() + c * n_ring);
+            scratch.result.push_back(copy.results.data() + c * result_size);
+          }
+        // Each patch writes its own records of the replies.
+        if (const auto members = remote.members.find(a);
+            members != remote.members.end())
+          for (const auto &[process, r] : members->second)
+            {
+              scratch.patch.push_back(remote.received.at(process).data() +
+                                      r * n_ring);
+              scratch.result.push_back(remote.replies.at(process).data() +
+                                       r * result_size);
+            }
+        // λ_a at a, zero on ∂ω (DiscreteAction::lambda_h()); a is not
+        // hanging.
+        scratch.problem.solve(lambda_h[a], scratch.patch, scratch.result);
       },
       [&](const PatchCopy &copy) {
         for (unsigned int c = 0; c < copy.n_cells; ++c)
           add_patch_result(local_members[copy.first + c].cell,
-                           copy.results.data() + c * 6 * basis.ring().size());
+                           copy.results.data() + c * 6 * n_ring);
       });
-  }
-
-
-
-  template <int dim>
-  void
-  FluxEquilibration<dim>::solve_patch(
-    const unsigned int               first,
-    const unsigned int               end,
-    const std::vector<PatchMember>  &local_members,
-    const AlignedVector<PatchTerms> &patch_terms,
-    const VectorType                &lambda_h,
-    RemotePatches                   &remote,
-    PatchScratch                    &scratch,
-    PatchCopy                       &copy) const
-  {
-    const unsigned int n_ring       = basis.ring().size();
-    const unsigned int result_size  = 6 * n_ring;
-    copy.first                      = first;
-    copy.n_cells                    = end - first;
-    const types::global_dof_index a = local_members[first].a;
-    scratch.records.resize(copy.n_cells * n_ring);
-    copy.results.assign(copy.n_cells * result_size, 0.);
-    scratch.patch.clear();
-    scratch.result.clear();
-    for (unsigned int c = 0; c < copy.n_cells; ++c)
-      {
-        const PatchMember &member = local_members[first + c];
-        write_patch_record(member.cell,
-                           a,
-                           member.coefficients,
-                           patch_terms,
-                           scratch.records.data() + c * n_ring);
-        scratch.patch.push_back(scratch.records.data() + c * n_ring);
-        scratch.result.push_back(copy.results.data() + c * result_size);
-      }
-    // Each patch writes its own records of the replies.
-    if (const auto members = remote.members.find(a);
-        members != remote.members.end())
-      for (const auto &[process, r] : members->second)
-        {
-          scratch.patch.push_back(remote.received.at(process).data() +
-                                  r * n_ring);
-          scratch.result.push_back(remote.replies.at(process).data() +
-                                   r * result_size);
-        }
-    // λ_a at a, zero on ∂ω (DiscreteAction::lambda_h()); a is not hanging.
-    scratch.problem.solve(lambda_h[a], scratch.patch, scratch.result);
   }
 
 

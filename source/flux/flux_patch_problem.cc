@@ -11,6 +11,8 @@ namespace membranes
 {
   namespace
   {
+    constexpr unsigned int invalid = numbers::invalid_unsigned_int;
+
     /** At most 8 sub-triangles per cell, and the circulation. */
     constexpr unsigned int max_cell_unknowns = 9;
 
@@ -32,14 +34,6 @@ namespace membranes
     : n_ring(n_ring)
   {
     AssertIndexRange(n_ring, max_cell_unknowns);
-  }
-
-
-
-  const PatchRecord &
-  PatchProblem::record(const unsigned int s) const
-  {
-    return (*patch)[s / n_ring][s % n_ring];
   }
 
 
@@ -108,14 +102,6 @@ namespace membranes
 
 
 
-  /**
-   * The divergence of σ_ih^a on each sub-triangle, ∫_κ r_ia with
-   * r_ia = (f_i + s_i λ_a) φ_a − μ_i ∇u_ih·∇φ_a, and the prescribed fluxes
-   * through ∂ω: those of −μ_i φ_a ∇u_ih, plus what ∫ r_ia leaves over,
-   * spread in proportion to ∫ φ_a on each half-edge. Around an interior
-   * vertex, ∫ r_ia = 0 is (4.5) for the condensed φ_a; what quadrature and
-   * the linear solver leave of it is spread as a constant instead.
-   */
   void
   PatchProblem::compute_sources(const double lambda_a)
   {
@@ -168,7 +154,6 @@ namespace membranes
   void
   PatchProblem::compute_targets()
   {
-    const unsigned int invalid = numbers::invalid_unsigned_int;
     target.resize(n_sub);
     mean.assign(n_x, {});
     weight.assign(n_x, 0.);
@@ -227,9 +212,8 @@ namespace membranes
   void
   PatchProblem::assemble_cell(const unsigned int c)
   {
-    const unsigned int invalid = numbers::invalid_unsigned_int;
-    const unsigned int z       = n_ring;
-    CellForm           form;
+    const unsigned int                                   z = n_ring;
+    CellForm                                             form;
     std::array<std::array<double, 2>, max_cell_unknowns> g_d, g_e;
     std::array<double, max_cell_unknowns> alpha, gamma, epsilon, suffix;
     std::array<double, 2>                 partial{}, known_total{};
@@ -327,7 +311,6 @@ namespace membranes
   void
   PatchProblem::write_fluxes(const std::vector<double *> &result) const
   {
-    const unsigned int invalid = numbers::invalid_unsigned_int;
     for (unsigned int c = 0; c < n_cells; ++c)
       for (unsigned int i = 0; i < 2; ++i)
         {

@@ -63,7 +63,6 @@ namespace membranes
 
 
 
-  /** The work arrays of one thread of compute_local_fluxes(). */
   template <int dim>
   struct FluxReconstruction<dim>::LocalFluxScratch
   {
@@ -75,7 +74,6 @@ namespace membranes
                   points.quadrature,
                   update_values | update_gradients | update_jacobians |
                     update_quadrature_points | update_JxW_values)
-      , local_dofs(discretization.fe->n_dofs_per_cell())
       , volume_points(points.n_volume)
     {
       for (auto &gradient : gradients)
@@ -84,8 +82,6 @@ namespace membranes
 
     const SubTrianglePoints<dim> &points;
     FEValues<dim>                 fe_values;
-    /** The nodal values of one membrane on the cell. */
-    std::vector<double> local_dofs;
     /** ∇u_ih at the points. */
     std::array<std::vector<Tensor<1, dim>>, 2> gradients;
     std::vector<Point<dim>>                    volume_points;
@@ -132,18 +128,17 @@ namespace membranes
 
 
 
-  template <int dim>
-  FluxReconstruction<dim>::FluxReconstruction(
-    const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data)
-    : discretization(discretization)
-    , data(data)
-    , dual_cell_quadrature(discretization.dual_cell_quadrature)
-    , basis(dual_cell_quadrature, *discretization.fe)
-  {}
-
-
-
+  /**
+   * The cell loop runs on the owned and the ghost cells: the cells along
+   * every half-edge of an owned cell (along the whole coarse edge at a
+   * hanging node) lie in them, so the half-edge rule gives the owned cells
+   * the same t_ih as on one process, without communication. (At the outer
+   * rim of the ghost layer, groups are cut short by artificial cells; they
+   * belong to no owned cell.) The patch problems need the owned cells only.
+   * Each cell writes its own entries of sub_triangle_data, patch_terms and
+   * load_at_points; the minimizers then give the fluxes of t_ih through the
+   * half-edges.
+   */
   template <int dim>
   AlignedVector<typename FluxReconstruction<dim>::PatchTerms>
   FluxReconstruction<dim>::reconstruct(const DoFHandler<dim> &dof_handler,
@@ -164,39 +159,12 @@ namespace membranes
     patch_terms.resize_fast(n_cells * n_triangles);
     hat_integrals.assign(n_cells, {});
 
-    set_half_edge_fluxes(dof_handler,
-                         compute_local_fluxes(dof_handler,
-                                              ghosted_solution,
-                                              patch_terms));
-    return patch_terms;
-  }
-
-
-
-  /**
-   * The loop runs on the owned and the ghost cells: the cells along every
-   * half-edge of an owned cell (along the whole coarse edge at a hanging
-   * node) lie in them, so the half-edge rule gives the owned cells the same
-   * t_ih as on one process, without communication. (At the outer rim of
-   * the ghost layer, groups are cut short by artificial cells; they belong
-   * to no owned cell.) The patch problems need the owned cells only. Each
-   * cell writes its own entries of sub_triangle_data, patch_terms and
-   * load_at_points.
-   */
-  template <int dim>
-  typename FluxReconstruction<dim>::HalfEdgeMinimization
-  FluxReconstruction<dim>::compute_local_fluxes(
-    const DoFHandler<dim>     &dof_handler,
-    const BlockVectorType     &ghosted_solution,
-    AlignedVector<PatchTerms> &patch_terms)
-  {
-    const unsigned int   n_entries = sub_triangle_data.size();
     HalfEdgeMinimization minimization;
     minimization.free_flux_index.assign(
       2 * dof_handler.get_triangulation().n_raw_faces(),
       numbers::invalid_unsigned_int);
-    minimization.free_flux_of.resize(n_entries);
-    minimization.free_fluxes.reserve(n_entries);
+    minimization.free_flux_of.resize(sub_triangle_data.size());
+    minimization.free_fluxes.reserve(sub_triangle_data.size());
     run_on_cells<LocalFluxCopy>(
       dof_handler,
       [&]() {
@@ -212,7 +180,19 @@ namespace membranes
       [&](const LocalFluxCopy &copy) {
         add_to_minimization(copy, minimization);
       });
-    return minimization;
+
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for (unsigned int s = 0; s < n_triangles; ++s)
+          {
+            const unsigned int id = cell->active_cell_index() * n_triangles + s;
+            const auto [index, factor] = minimization.free_flux_of[id];
+            const FreeFlux<dim> &free  = minimization.free_fluxes[index];
+            for (unsigned int i = 0; i < 2; ++i)
+              sub_triangle_data[id].fluxes[i][2] =
+                factor * free.numerator[i] / free.denominator;
+          }
+    return patch_terms;
   }
 
 
@@ -240,17 +220,9 @@ namespace membranes
     copy.cell = cell->active_cell_index();
     copy.half_edges.resize(n_triangles);
     scratch.fe_values.reinit(cell);
-    // ∇u_ih from the nodal values of block i, read into the buffer of the
-    // scratch.
     for (unsigned int i = 0; i < 2; ++i)
-      {
-        cell->get_dof_values(ghosted_solution.block(i),
-                             scratch.local_dofs.begin(),
-                             scratch.local_dofs.end());
-        scratch.fe_values[FEValuesExtractors::Scalar(0)]
-          .get_function_gradients_from_local_dof_values(scratch.local_dofs,
-                                                        scratch.gradients[i]);
-      }
+      scratch.fe_values.get_function_gradients(ghosted_solution.block(i),
+                                               scratch.gradients[i]);
     for (unsigned int q = 0; q < n_volume; ++q)
       scratch.volume_points[q] = scratch.fe_values.quadrature_point(q);
     data.load_list(scratch.volume_points, scratch.load);
@@ -302,22 +274,20 @@ namespace membranes
     for (unsigned int e = 0; e < (owned ? 3 : 2); ++e)
       for (unsigned int k = 0; k < points.n_edge_points; ++k)
         {
-          const unsigned int   q = points.edge_point(s, e, k);
-          const Tensor<2, dim> DF =
-            jacobian_matrix(scratch.fe_values.jacobian(q));
+          const unsigned int   q  = points.edge_point(s, e, k);
+          const Tensor<2, dim> DF = scratch.fe_values.jacobian(q);
           const Tensor<1, dim> n_ds =
             std::abs(determinant(DF)) * transpose(invert(DF)) *
             triangle.normals[e] * points.quadrature.weight(q);
-          std::array<double, 2> flux_density;
           for (unsigned int i = 0; i < 2; ++i)
             {
-              flux_density[i] = data.mu[i] * scratch.gradients[i][q] * n_ds;
+              const double flux_density =
+                data.mu[i] * scratch.gradients[i][q] * n_ds;
               if (e < 2)
-                kappa.fluxes[i][e] -= flux_density[i];
+                kappa.fluxes[i][e] -= flux_density;
+              if (owned)
+                terms.edge_flux[i][e][k] = flux_density;
             }
-          if (owned)
-            for (unsigned int i = 0; i < 2; ++i)
-              terms.edge_flux[i][e][k] = flux_density[i];
           if (owned && e == 2 && cell->at_boundary(triangle.face))
             terms.boundary_length[k] = n_ds.norm();
         }
@@ -325,11 +295,6 @@ namespace membranes
 
 
 
-  /**
-   * The Gram matrix of the mapped basis ψ_k and of the rotations β_l,
-   * (μ_i ∇u_ih, ψ_k), (μ_i ∇u_ih, β_l), the area, ∫ f_i, and the hat
-   * function terms on κ.
-   */
   template <int dim>
   void
   FluxReconstruction<dim>::integrate_sub_triangle(
@@ -347,8 +312,8 @@ namespace membranes
     for (unsigned int q = 0; q < scratch.points.n_volume; ++q)
       if (dual_cell_quadrature.sub_triangle_of_point(q) == s)
         {
-          const Tensor<2, dim> DF  = jacobian_matrix(fe_values.jacobian(q));
-          const double         det = std::abs(determinant(DF));
+          const Tensor<2, dim>          DF  = fe_values.jacobian(q);
+          const double                  det = std::abs(determinant(DF));
           std::array<Tensor<1, dim>, 3> psi;
           for (unsigned int k = 0; k < 3; ++k)
             psi[k] = DF * basis.flux_basis(q)[k] / det;
@@ -501,28 +466,6 @@ namespace membranes
 
 
   template <int dim>
-  void
-  FluxReconstruction<dim>::set_half_edge_fluxes(
-    const DoFHandler<dim>      &dof_handler,
-    const HalfEdgeMinimization &minimization)
-  {
-    const unsigned int n_triangles = basis.n_sub_triangles();
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        for (unsigned int s = 0; s < n_triangles; ++s)
-          {
-            const unsigned int id = cell->active_cell_index() * n_triangles + s;
-            const auto [index, factor] = minimization.free_flux_of[id];
-            const FreeFlux<dim> &free  = minimization.free_fluxes[index];
-            for (unsigned int i = 0; i < 2; ++i)
-              sub_triangle_data[id].fluxes[i][2] =
-                factor * free.numerator[i] / free.denominator;
-          }
-  }
-
-
-
-  template <int dim>
   typename FluxReconstruction<dim>::DualCellSums
   FluxReconstruction<dim>::dual_cell_sums(
     const DoFHandler<dim>           &dof_handler,
@@ -530,9 +473,8 @@ namespace membranes
     const IndexSet                  &locally_owned_dofs,
     const MPI_Comm                   mpi_communicator) const
   {
-    const FiniteElement<dim> &fe          = dof_handler.get_fe();
-    const auto               &triangles   = basis.sub_triangles();
-    const unsigned int        n_triangles = triangles.size();
+    const auto        &triangles   = basis.sub_triangles();
+    const unsigned int n_triangles = triangles.size();
 
     // Per cell and vertex v the measure of K ∩ D_v and, in block i, the
     // integral of div t_ih over it, f_ih meas(K ∩ D_v) and f_ih ∫_K φ_v,
@@ -540,19 +482,18 @@ namespace membranes
     // function of vertex v is shape function v of the P1/Q1 element.
     DualCellSums sums;
     sums.measure.reinit(locally_owned_dofs, mpi_communicator);
-    for (auto *vector :
-         {&sums.divergence, &sums.load_on_pieces, &sums.load_on_hats})
+    const std::array<BlockVectorType *, 3> blocks{
+      {&sums.divergence, &sums.load_on_pieces, &sums.load_on_hats}};
+    for (auto *vector : blocks)
       vector->reinit(std::vector<IndexSet>(2, locally_owned_dofs),
                      mpi_communicator);
-    const unsigned int            dofs_per_cell = fe.n_dofs_per_cell();
-    Vector<double>                local_measure(dofs_per_cell);
-    std::array<Vector<double>, 2> local_divergence, local_load_on_pieces,
-      local_load_on_hats;
-    for (unsigned int i = 0; i < 2; ++i)
-      for (auto *local : {&local_divergence[i],
-                          &local_load_on_pieces[i],
-                          &local_load_on_hats[i]})
-        local->reinit(dofs_per_cell);
+    const unsigned int dofs_per_cell = dof_handler.get_fe().n_dofs_per_cell();
+    Vector<double>     local_measure(dofs_per_cell);
+    // Per membrane the local parts of the vectors of blocks.
+    std::array<std::array<Vector<double>, 3>, 2> local;
+    for (auto &membrane : local)
+      for (auto &vector : membrane)
+        vector.reinit(dofs_per_cell);
     std::vector<types::global_dof_index> dof_indices(dofs_per_cell);
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -571,44 +512,32 @@ namespace membranes
             }
           local_measure = 0;
           for (unsigned int i = 0; i < 2; ++i)
-            local_divergence[i] = 0;
+            local[i][0] = 0;
           for (unsigned int s = 0; s < n_triangles; ++s)
             {
               const unsigned int v = triangles[s].vertex;
               local_measure(v) += kappa[s].area;
               for (unsigned int i = 0; i < 2; ++i)
-                local_divergence[i](v) += kappa[s].fluxes[i][0] +
-                                          kappa[s].fluxes[i][1] +
-                                          kappa[s].fluxes[i][2];
+                local[i][0](v) += kappa[s].fluxes[i][0] +
+                                  kappa[s].fluxes[i][1] + kappa[s].fluxes[i][2];
             }
           for (const unsigned int v : cell->vertex_indices())
             for (unsigned int i = 0; i < 2; ++i)
               {
-                local_load_on_pieces[i](v) =
-                  load_mean[i] / area * local_measure(v);
-                // f_ih ∫_K φ_v.
-                local_load_on_hats[i](v) =
-                  load_mean[i] / area *
-                  hat_integrals[cell->active_cell_index()][v];
+                local[i][1](v) = load_mean[i] / area * local_measure(v);
+                local[i][2](v) = load_mean[i] / area *
+                                 hat_integrals[cell->active_cell_index()][v];
               }
           hanging_node_constraints.distribute_local_to_global(local_measure,
                                                               dof_indices,
                                                               sums.measure);
           for (unsigned int i = 0; i < 2; ++i)
-            {
+            for (unsigned int k = 0; k < 3; ++k)
               hanging_node_constraints.distribute_local_to_global(
-                local_divergence[i], dof_indices, sums.divergence.block(i));
-              hanging_node_constraints.distribute_local_to_global(
-                local_load_on_pieces[i],
-                dof_indices,
-                sums.load_on_pieces.block(i));
-              hanging_node_constraints.distribute_local_to_global(
-                local_load_on_hats[i], dof_indices, sums.load_on_hats.block(i));
-            }
+                local[i][k], dof_indices, blocks[k]->block(i));
         }
     sums.measure.compress(VectorOperation::add);
-    for (auto *vector :
-         {&sums.divergence, &sums.load_on_pieces, &sums.load_on_hats})
+    for (auto *vector : blocks)
       vector->compress(VectorOperation::add);
     return sums;
   }
@@ -678,11 +607,9 @@ namespace membranes
                                        const unsigned int  i) const
   {
     const unsigned int n_points = dual_cell_quadrature.quadrature().size();
-    return make_array_view(load_at_points.data() +
-                             (2 * cell->active_cell_index() + i) * n_points,
-                           load_at_points.data() +
-                             (2 * cell->active_cell_index() + i + 1) *
-                               n_points);
+    const double      *first =
+      load_at_points.data() + (2 * cell->active_cell_index() + i) * n_points;
+    return make_array_view(first, first + n_points);
   }
 
 
@@ -731,11 +658,10 @@ namespace membranes
                   .fluxes;
               for (unsigned int j = 0; j < 3; ++j)
                 {
-                  const unsigned int q = points.corner_point(s, j);
-                  patch.vertices[j]    = fe_values.quadrature_point(q);
-                  const Tensor<2, dim> DF =
-                    jacobian_matrix(fe_values.jacobian(q));
-                  const double det = std::abs(determinant(DF));
+                  const unsigned int q     = points.corner_point(s, j);
+                  patch.vertices[j]        = fe_values.quadrature_point(q);
+                  const Tensor<2, dim> DF  = fe_values.jacobian(q);
+                  const double         det = std::abs(determinant(DF));
                   patch.data(0, j) = cell->vertex_index(triangles[s].vertex);
                   patch.data(1, j) =
                     dual_mesh.lambda_h_value(cell,
@@ -757,24 +683,6 @@ namespace membranes
             }
         }
     return patches;
-  }
-
-
-
-  template <int dim>
-  const SubTriangleBasis<dim> &
-  FluxReconstruction<dim>::sub_triangle_basis() const
-  {
-    return basis;
-  }
-
-
-
-  template <int dim>
-  const AlignedVector<typename FluxReconstruction<dim>::SubTriangleData> &
-  FluxReconstruction<dim>::sub_triangles() const
-  {
-    return sub_triangle_data;
   }
 
 

@@ -43,6 +43,10 @@ namespace membranes
       std::array<double, 3> u;
     };
 
+    /** The vertices of S_h at the corners of a sub-triangle, weighted. */
+    using CornerNodes =
+      std::array<std::array<std::pair<unsigned int, double>, 2>, 3>;
+
     /**
      * Call @p f on every vertex of @p vertices, on threads: the vertices of
      * one kind share no sub-triangle, so their updates touch disjoint data
@@ -92,17 +96,16 @@ namespace membranes
      * their number per corner.
      */
     template <typename CellIterator, typename SubTriangle>
-    std::pair<std::array<std::array<std::pair<unsigned int, double>, 2>, 3>,
-              std::array<unsigned int, 3>>
+    std::pair<CornerNodes, std::array<unsigned int, 3>>
     sub_mesh_vertices(const CellIterator &cell,
                       const SubTriangle  &triangle,
                       const unsigned int  n_vertices,
                       const unsigned int  first_cell)
     {
-      const unsigned int f        = triangle.face;
-      const auto         face     = cell->face(f);
-      const bool         boundary = cell->at_boundary(f);
-      std::array<std::array<std::pair<unsigned int, double>, 2>, 3> nodes;
+      const unsigned int          f        = triangle.face;
+      const auto                  face     = cell->face(f);
+      const bool                  boundary = cell->at_boundary(f);
+      CornerNodes                 nodes;
       std::array<unsigned int, 3> n_nodes_of{{1, 1, 1}};
       nodes[0][0] = {cell->vertex_index(triangle.vertex), 1.};
       if (!boundary && face->has_children())
@@ -129,14 +132,12 @@ namespace membranes
      * [@p first_entry, end) of @p entries or to a new one.
      */
     void
-    add_rotation_entries(
-      const std::array<std::array<std::pair<unsigned int, double>, 2>, 3>
-                                        &nodes,
-      const std::array<unsigned int, 3> &n_nodes_of,
-      const std::array<unsigned int, 3> &order,
-      const unsigned int                 kappa,
-      const std::size_t                  first_entry,
-      std::vector<RotationEntry>        &entries)
+    add_rotation_entries(const CornerNodes                 &nodes,
+                         const std::array<unsigned int, 3> &n_nodes_of,
+                         const std::array<unsigned int, 3> &order,
+                         const unsigned int                 kappa,
+                         const std::size_t                  first_entry,
+                         std::vector<RotationEntry>        &entries)
     {
       for (unsigned int k = 0; k < 3; ++k)
         {
@@ -213,21 +214,17 @@ namespace membranes
     const auto first_of = [&](const auto &cell) {
       return sigma.begin() + cell->active_cell_index() * n_triangles;
     };
-    const auto update_ghosts = [&]() {
-      GridTools::exchange_cell_data_to_ghosts<CellFluxes, DoFHandler<dim>>(
-        dof_handler,
-        [&](const auto &cell) {
-          return CellFluxes(first_of(cell), first_of(cell) + n_triangles);
-        },
-        [&](const auto &cell, const CellFluxes &fluxes) {
-          std::copy(fluxes.begin(), fluxes.end(), first_of(cell));
-        });
-    };
-
     for (unsigned int sweep = 0; sweep < rotation_sweeps; ++sweep)
       for (const unsigned int kind : Rotations::sweep_order)
         {
-          update_ghosts();
+          GridTools::exchange_cell_data_to_ghosts<CellFluxes, DoFHandler<dim>>(
+            dof_handler,
+            [&](const auto &cell) {
+              return CellFluxes(first_of(cell), first_of(cell) + n_triangles);
+            },
+            [&](const auto &cell, const CellFluxes &fluxes) {
+              std::copy(fluxes.begin(), fluxes.end(), first_of(cell));
+            });
           for_each_vertex(rotations.vertices_of_kind[kind],
                           [&](const RotationVertex &p) {
                             const auto           &all = rotations.rotations;
@@ -337,29 +334,20 @@ namespace membranes
     result.rotations.resize(n_rotations);
     for (const RotationEntry &entry : entries)
       if (count[entry.node] > 0)
-        {
-          Rotation &rotation = result.rotations[next[entry.node]++];
-          rotation.kappa     = entry.kappa;
-          rotation.u         = entry.u;
-        }
+        result.rotations[next[entry.node]++] = {entry.kappa, entry.u, {}, {}};
     for (const unsigned int kind : Rotations::sweep_order)
       for_each_vertex(result.vertices_of_kind[kind], [&](RotationVertex &p) {
         for (unsigned int t = p.begin; t < p.end; ++t)
           {
             Rotation   &rotation = result.rotations[t];
             const auto &kappa = reconstruction.sub_triangles()[rotation.kappa];
+            // Gu and ug start at zero.
             for (unsigned int k = 0; k < 3; ++k)
-              {
-                rotation.Gu[k] = 0;
-                for (unsigned int l = 0; l < 3; ++l)
-                  rotation.Gu[k] += kappa.gram[k][l] * rotation.u[l];
-              }
+              for (unsigned int l = 0; l < 3; ++l)
+                rotation.Gu[k] += kappa.gram[k][l] * rotation.u[l];
             for (unsigned int i = 0; i < 2; ++i)
-              {
-                rotation.ug[i] = 0;
-                for (unsigned int k = 0; k < 3; ++k)
-                  rotation.ug[i] += rotation.u[k] * kappa.discrete_flux[i][k];
-              }
+              for (unsigned int k = 0; k < 3; ++k)
+                rotation.ug[i] += rotation.u[k] * kappa.discrete_flux[i][k];
             for (unsigned int k = 0; k < 3; ++k)
               p.denominator += rotation.u[k] * rotation.Gu[k];
           }
@@ -404,12 +392,9 @@ namespace membranes
       return l == 0 ? n_vertices + triangles[s].face : triangles[s].vertex;
     };
     FullMatrix<double>            bubble_gram(2 * n_vertices);
-    std::array<Vector<double>, 2> right_hand_side, coefficients;
-    for (unsigned int i = 0; i < 2; ++i)
-      {
-        right_hand_side[i].reinit(2 * n_vertices);
-        coefficients[i].reinit(2 * n_vertices);
-      }
+    const Vector<double>          zero(2 * n_vertices);
+    std::array<Vector<double>, 2> right_hand_side{{zero, zero}},
+      coefficients{{zero, zero}};
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {

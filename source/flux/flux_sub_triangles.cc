@@ -3,6 +3,39 @@
 
 namespace membranes
 {
+  namespace
+  {
+    /**
+     * The curl of the edge bubble 4 λ_p λ_q of edge @p l of the reference
+     * sub-triangle with @p corners (p, q the ends of the edge, λ the
+     * barycentric coordinates) at the reference point @p x.
+     */
+    template <int dim>
+    Tensor<1, dim>
+    reference_rotation(const std::array<Point<dim>, 3> &corners,
+                       const unsigned int               l,
+                       const Point<dim>                &x)
+    {
+      // λ_j is the linear function that is 1 at the corner c_j and 0 on the
+      // line through the other two, r·(x − c_{j+1}) / r·(c_j − c_{j+1}) with
+      // r normal to c_{j+2} − c_{j+1}; 4 λ_p λ_q has the gradient
+      // 4 (λ_p ∇λ_q + λ_q ∇λ_p), and the curl is (∂_y, −∂_x).
+      const auto barycentric = [&](const unsigned int j) {
+        const Tensor<1, dim> d = corners[(j + 2) % 3] - corners[(j + 1) % 3];
+        const double         scale =
+          cross_product_2d(d) * (corners[j] - corners[(j + 1) % 3]);
+        return std::make_pair(cross_product_2d(d) * (x - corners[(j + 1) % 3]) /
+                                scale,
+                              Tensor<1, dim>(cross_product_2d(d) / scale));
+      };
+      const auto [lambda_p, grad_p] = barycentric((l + 1) % 3);
+      const auto [lambda_q, grad_q] = barycentric((l + 2) % 3);
+      return cross_product_2d(4 * (lambda_p * grad_q + lambda_q * grad_p));
+    }
+  } // namespace
+
+
+
   template <int dim>
   SubTrianglePoints<dim>::SubTrianglePoints(const DualCellQuadrature<dim> &dual,
                                             const bool with_corners)
@@ -59,18 +92,16 @@ namespace membranes
     // points of the dual quadrature.
     for (unsigned int q = 0; q < points.n_volume; ++q)
       {
-        const unsigned int            s = dual.sub_triangle_of_point(q);
-        const Point<dim>             &x = points.quadrature.point(q);
+        const unsigned int            s        = dual.sub_triangle_of_point(q);
+        const Point<dim>             &x        = points.quadrature.point(q);
+        const auto                   &triangle = dual.sub_triangles()[s];
         std::array<Tensor<1, dim>, 3> psi;
         for (unsigned int k = 0; k < 3; ++k)
-          {
-            std::array<double, 3> unit{};
-            unit[k] = 1;
-            psi[k]  = reference_flux(s, unit, x);
-          }
+          psi[k] = (x - triangle.corners[k]) / (2 * triangle.area);
         flux_basis_at_points.push_back(psi);
         rotation_basis_at_points.push_back(
-          {{reference_rotation(s, 0, x), reference_rotation(s, 1, x)}});
+          {{reference_rotation(triangle.corners, 0, x),
+            reference_rotation(triangle.corners, 1, x)}});
       }
 
     // Around b_K, sub-triangle (a, m_e, b_K) meets (a', m_e, b_K), a' the
@@ -107,36 +138,6 @@ namespace membranes
     for (unsigned int j = 0; j < 3; ++j)
       t += fluxes[j] * (x - triangle.corners[j]) / (2 * triangle.area);
     return t;
-  }
-
-
-
-  template <int dim>
-  Tensor<1, dim>
-  SubTriangleBasis<dim>::reference_rotation(const unsigned int s,
-                                            const unsigned int l,
-                                            const Point<dim>  &x) const
-  {
-    // λ_j is the linear function that is 1 at the corner c_j and 0 on the
-    // line through the other two, r·(x − c_{j+1}) / r·(c_j − c_{j+1}) with
-    // r normal to c_{j+2} − c_{j+1}; 4 λ_p λ_q has the gradient
-    // 4 (λ_p ∇λ_q + λ_q ∇λ_p), and the curl is (∂_y, −∂_x).
-    const auto &corners     = dual.sub_triangles()[s].corners;
-    const auto  barycentric = [&](const unsigned int j) {
-      const Tensor<1, dim> d = corners[(j + 2) % 3] - corners[(j + 1) % 3];
-      const double         scale =
-        cross_product_2d(d) * (corners[j] - corners[(j + 1) % 3]);
-      return std::make_pair(cross_product_2d(d) * (x - corners[(j + 1) % 3]) /
-                              scale,
-                            Tensor<1, dim>(cross_product_2d(d) / scale));
-    };
-    const auto [lambda_p, grad_p] = barycentric((l + 1) % 3);
-    const auto [lambda_q, grad_q] = barycentric((l + 2) % 3);
-    const Tensor<1, dim> gradient = 4 * (lambda_p * grad_q + lambda_q * grad_p);
-    Tensor<1, dim>       curl;
-    curl[0] = gradient[1];
-    curl[1] = -gradient[0];
-    return curl;
   }
 
 

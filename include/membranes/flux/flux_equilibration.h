@@ -1,17 +1,10 @@
 #ifndef membranes_flux_equilibration_h
 #define membranes_flux_equilibration_h
 
-#include <array>
-#include <deal.II/base/aligned_vector.h>
-#include <deal.II/base/index_set.h>
-#include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_values.h>
-#include <deal.II/lac/affine_constraints.h>
-#include <deal.II/lac/trilinos_vector.h>
 #include <map>
 #include <membranes/flux/flux_patch_problem.h>
 #include <membranes/flux/flux_reconstruction.h>
-#include <membranes/flux/flux_sub_triangles.h>
 #include <utility>
 #include <vector>
 
@@ -58,33 +51,16 @@ namespace membranes
    * −μ_i φ_a ∇u_ih itself instead loses this: the sum of the patch
    * minimizers is then off by O(|∇u_ih|) in a strip of cells along ∂ω
    * and wherever the mesh changes direction, an effectivity that grows
-   * like h^{−1/2}.) At an edge with a hanging node the two halves of a
-   * small edge on the fine side carry one flux density (one unknown with
-   * the coarse side's half-edge), which keeps σ_ih conforming; T_ia
-   * differs there between the two halves, so its two fluxes are replaced
-   * by one density and what moves between the two sub-triangles of the
-   * face goes back through the edge m_e–b_K between them (half the
-   * difference of the two changes each way). Where u_ih is linear the two
-   * changes are opposite (the fine side's fluxes add up to the coarse
-   * side's), T_ia so changed is admissible, and σ_ih = −μ_i ∇u_ih exactly
-   * also with hanging nodes.
+   * like h^{−1/2}.) At an edge with a hanging node T_ia is made to take
+   * one flux density on the two halves of a small edge, which keeps this
+   * exactness (see PatchProblem::compute_targets()).
    *
    * The sum of the patch minimizers is not the field of RT0(S_h) with
-   * this divergence that is closest to −μ_i ∇u_ih. Three sweeps of
-   * divergence-free corrections bring it closer (relax_rotations()): the
-   * curl of the hat function of each vertex p of S_h (a, m_e or b_K) is a
-   * rotation of the fluxes around p, and its coefficient is the one that
-   * minimizes ‖μ_i^{-1/2} σ_ih + μ_i^{1/2} ∇u_ih‖ on the sub-triangles
-   * around p. Neither div σ_ih nor its normal continuity change, and the
-   * flux estimator only decreases. At an edge with a hanging vertex c the
-   * stream function stays continuous on S_h: c is the coarse side's m_e,
-   * and the midpoints of the two small edges take half of the hat
-   * functions of their ends, which carries the corrections across.
-   * Vertices on ∂ω are left out: the normal flux there stays that of the
-   * patch problems. Last, inside
-   * each cell, the curls of the quadratic edge bubbles of the edges of S_h
-   * through b_K (relax_cell_rotations()) follow the bilinear part of a Q1
-   * gradient, which no RT0 field of the sub-triangles does.
+   * this divergence that is closest to −μ_i ∇u_ih. Divergence-free
+   * corrections bring it closer, and the flux estimator only decreases:
+   * rotations around the vertices of S_h not on ∂ω (relax_rotations()),
+   * then, inside each cell, the curls of the edge bubbles of the edges of
+   * S_h through b_K (relax_cell_rotations()).
    *
    * Each patch problem is a PatchProblem; the sub-triangles and their
    * Raviart–Thomas basis are a SubTriangleBasis.
@@ -96,11 +72,6 @@ namespace membranes
    * of their end vertices, the same on every process), sends them
    * to the owner of a, which solves the patch problem and sends σ_ih^a back
    * (Utilities::MPI::some_to_some).
-   *
-   * The parts are in two files: the patch problems, their members and
-   * their exchange between processes in flux_equilibration.cc (the patch
-   * problem itself is PatchProblem, in flux_patch_problem.cc), the rotation
-   * relaxation in flux_rotations.cc.
    */
   template <int dim>
   class FluxEquilibration
@@ -114,7 +85,10 @@ namespace membranes
      * The equilibration of the fluxes of @p reconstruction, which must
      * live as long as this object.
      */
-    explicit FluxEquilibration(const FluxReconstruction<dim> &reconstruction);
+    explicit FluxEquilibration(const FluxReconstruction<dim> &reconstruction)
+      : reconstruction(reconstruction)
+      , basis(reconstruction.sub_triangle_basis())
+    {}
 
     /**
      * σ_ih = Σ_a σ_ih^a on the locally owned cells, by the patch problems
@@ -148,11 +122,12 @@ namespace membranes
 
     /** The reconstruction whose fluxes are equilibrated. */
     const FluxReconstruction<dim> &
-    get_reconstruction() const;
+    get_reconstruction() const
+    {
+      return reconstruction;
+    }
 
   private:
-    using EdgeKey = typename FluxReconstruction<dim>::EdgeKey;
-
     /** The coefficients of a condensed φ_a in the hat functions of a cell. */
     using HatCoefficients =
       std::array<double, GeometryInfo<dim>::vertices_per_cell>;
@@ -190,7 +165,6 @@ namespace membranes
 
     /** The work arrays of one thread of solve_patches(). */
     struct PatchScratch;
-    /** σ_ih^a of one patch on its owned cells. */
     struct PatchCopy;
 
     /**
@@ -225,20 +199,6 @@ namespace membranes
                   RemotePatches                   &remote);
 
     /**
-     * The worker of solve_patches(): the patch problem of the members
-     * local_members[first, end), which share their a.
-     */
-    void
-    solve_patch(const unsigned int               first,
-                const unsigned int               end,
-                const std::vector<PatchMember>  &local_members,
-                const AlignedVector<PatchTerms> &patch_terms,
-                const VectorType                &lambda_h,
-                RemotePatches                   &remote,
-                PatchScratch                    &scratch,
-                PatchCopy                       &copy) const;
-
-    /**
      * Write the records of the sub-triangles of @p cell (in the order of
      * the ring) for the patch problem of the condensed hat function φ_a
      * with @p coefficients on @p cell to @p record.
@@ -254,34 +214,20 @@ namespace membranes
     void
     add_patch_result(const CellIterator &cell, const double *result);
 
-    /** The rotations around the vertices of S_h (see the .cc file). */
     struct Rotations;
 
-    /**
-     * Divergence-free corrections of σ_ih on the locally owned cells: the
-     * curls of the hat functions of the vertices of S_h, each chosen to
-     * minimize the distance of σ_ih from −μ_i ∇u_ih around its vertex,
-     * in rotation_sweeps sweeps (see the .cc file).
-     */
+    /** The rotations around the vertices of S_h (see the .cc file). */
     void
     relax_rotations(const DoFHandler<dim> &dof_handler);
 
-    /**
-     * The rotations around the vertices p of S_h not on ∂ω that an owned
-     * cell touches, grouped by the kind of p.
-     */
+    /** The rotations of relax_rotations() (see the .cc file). */
     Rotations
     rotations_around_vertices(const DoFHandler<dim> &dof_handler) const;
 
     /** Sweeps of relax_rotations(). */
     static constexpr unsigned int rotation_sweeps = 3;
 
-    /**
-     * Rotations inside each locally owned cell: the curls of the edge
-     * bubbles of the edges of S_h through b_K, with the coefficients that
-     * minimize the distance of σ_ih from −μ_i ∇u_ih on the cell (see the
-     * .cc file).
-     */
+    /** The rotations inside each cell (see the .cc file). */
     void
     relax_cell_rotations(const DoFHandler<dim> &dof_handler);
 

@@ -17,23 +17,16 @@ namespace membranes
    * The record of one sub-triangle κ of a cell K in the support of a
    * condensed hat function φ_a: what the patch problem of a needs of κ,
    * with φ_a's coefficients on K applied. The process that owns K writes
-   * it; the process that owns a solves the patch problem (in general
-   * another process: the support of a condensed φ_a can reach beyond the
-   * ghost layer of a process that owns one of its cells). The type is
+   * it; the process that owns a solves the patch problem (see
+   * FluxEquilibration). The type is
    * trivially copyable, so that records travel in MPI messages as they are,
    * with the DoF indices as integers.
    */
   struct PatchRecord
   {
-    /**
-     * The global DoF index of the vertex a of the patch (the same in both
-     * blocks).
-     */
+    /** The global DoF index of the vertex a of the patch (in both blocks). */
     types::global_dof_index vertex;
-    /**
-     * The key of the unknown flux through edge 2 of κ: the global DoF
-     * indices of the ends of its half-edge (see FluxReconstruction::EdgeKey).
-     */
+    /** The FluxReconstruction::EdgeKey of the flux through edge 2 of κ. */
     std::array<types::global_dof_index, 2> key;
     /** Outward flux of κ through edge 2 = factor × the unknown. */
     double factor;
@@ -69,18 +62,10 @@ namespace membranes
 
   /**
    * The local problem of FluxEquilibration on the support ω_a of a
-   * condensed hat function φ_a: the field σ_ih^a in
-   * the Raviart–Thomas space Z_h of (4.12) on ω_a with
-   *
-   *   ∫_κ div σ_ih^a = ∫_κ r_ia,  r_ia = (f_i + s_i λ_a) φ_a
-   *                                      − μ_i ∇u_ih·∇φ_a,
-   *
-   * on every sub-triangle κ, zero normal flux on ∂ω_a inside ω and the
-   * prescribed normal flux on ∂ω, closest in the L² norm of the Gram
-   * matrices of the sub-triangles to the RT0 field T_ia with the fluxes of
-   * −μ_i φ_a ∇u_ih (see the class comment of FluxEquilibration). Around an
-   * interior vertex the problem is solvable because ∫ r_ia = 0 is (4.5) for
-   * the condensed φ_a.
+   * condensed hat function φ_a (see its class comment): the field σ_ih^a in
+   * Z_h of (4.12) on ω_a with ∫_κ div σ_ih^a = ∫_κ r_ia on every
+   * sub-triangle κ and the given normal fluxes on ∂ω_a, closest in the L²
+   * norm of the Gram matrices of the sub-triangles to T_ia.
    *
    * On each cell the sub-triangles form a ring around b_K; with the fluxes
    * through their half-edges and one circulation per cell, the divergence
@@ -113,7 +98,10 @@ namespace membranes
   private:
     /** The record of sub-triangle ring[s % n_ring] of cell s / n_ring. */
     const PatchRecord &
-    record(const unsigned int s) const;
+    record(const unsigned int s) const
+    {
+      return (*patch)[s / n_ring][s % n_ring];
+    }
 
     /**
      * Number the unknown fluxes: the half-edges (or small edges at a
@@ -123,7 +111,8 @@ namespace membranes
     number_unknowns();
 
     /**
-     * The divergences ∫_κ r_ia and the prescribed fluxes through ∂ω.
+     * The divergences ∫_κ r_ia and the prescribed fluxes through ∂ω (see
+     * the class comment of FluxEquilibration).
      */
     void
     compute_sources(const double lambda_a);
@@ -132,10 +121,7 @@ namespace membranes
     void
     compute_targets();
 
-    /**
-     * Add the quadratic form of the minimization on cell @p c and its
-     * constraint to the system.
-     */
+    /** Add the minimization on cell @p c and its constraint (see .cc). */
     void
     assemble_cell(const unsigned int c);
 

@@ -6,14 +6,10 @@
 #include <deal.II/base/array_view.h>
 #include <deal.II/base/data_out_base.h>
 #include <deal.II/base/index_set.h>
-#include <deal.II/base/quadrature.h>
 #include <deal.II/dofs/dof_handler.h>
-#include <deal.II/fe/fe_values.h>
-#include <deal.II/grid/reference_cell.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_vector.h>
-#include <map>
 #include <membranes/dual_mesh/discrete_action.h>
 #include <membranes/dual_mesh/dual_cell_quadrature.h>
 #include <membranes/dual_mesh/dual_mesh.h>
@@ -132,7 +128,12 @@ namespace membranes
     };
 
     FluxReconstruction(const Discretization<dim> &discretization,
-                       const ProblemData<dim>    &data);
+                       const ProblemData<dim>    &data)
+      : discretization(discretization)
+      , data(data)
+      , dual_cell_quadrature(discretization.dual_cell_quadrature)
+      , basis(dual_cell_quadrature, *discretization.fe)
+    {}
 
     /**
      * An edge or a half-edge of the mesh, by the global DoF indices of its
@@ -247,38 +248,33 @@ namespace membranes
 
     /** The sub-triangles and their Raviart–Thomas basis. */
     const SubTriangleBasis<dim> &
-    sub_triangle_basis() const;
+    sub_triangle_basis() const
+    {
+      return basis;
+    }
 
     /**
      * The SubTriangleData of the last reconstruct(), by active cell index ×
      * sub-triangles per cell + sub-triangle.
      */
     const AlignedVector<SubTriangleData> &
-    sub_triangles() const;
+    sub_triangles() const
+    {
+      return sub_triangle_data;
+    }
 
   private:
-    /** @name The fluxes t_ih of (4.13) (flux_reconstruction.cc) */
-    /** @{ */
-
-    /** The work arrays of one thread of compute_local_fluxes(). */
+    /** The work arrays of one thread of the cell loop of reconstruct(). */
     struct LocalFluxScratch;
-    /** What one cell gives the minimization of the half-edge fluxes. */
     struct LocalFluxCopy;
-    /** The unknown half-edge fluxes of the minimization and their sums. */
     struct HalfEdgeMinimization;
 
     /**
-     * On the owned and ghost cells the fluxes (4.13) through the edges of
-     * the sub-triangles inside the cells, the inner products of the
-     * minimization and, on the owned cells, the @p patch_terms; the sums of
-     * the minimization of the half-edge fluxes are returned.
+     * The worker of the cell loop of reconstruct() on @p cell, on the owned
+     * and ghost cells: the fluxes (4.13) through the edges of the
+     * sub-triangles inside the cell, the inner products of the minimization
+     * and, on an owned cell, the @p patch_terms.
      */
-    HalfEdgeMinimization
-    compute_local_fluxes(const DoFHandler<dim>     &dof_handler,
-                         const BlockVectorType     &ghosted_solution,
-                         AlignedVector<PatchTerms> &patch_terms);
-
-    /** The worker of compute_local_fluxes() on @p cell. */
     void
     local_fluxes_on_cell(const CellIterator        &cell,
                          const BlockVectorType     &ghosted_solution,
@@ -286,11 +282,7 @@ namespace membranes
                          LocalFluxScratch          &scratch,
                          LocalFluxCopy             &copy);
 
-    /**
-     * The fluxes (4.13) through the edges 0 and 1 of sub-triangle @p s of
-     * the cell of @p scratch and, on an owned cell, the flux densities of
-     * μ_i ∇u_ih through all three edges for the patch problems.
-     */
+    /** The edge integrals of sub-triangle @p s (see the .cc file). */
     void
     integrate_edge_fluxes(const CellIterator     &cell,
                           const unsigned int      s,
@@ -298,10 +290,7 @@ namespace membranes
                           SubTriangleData        &kappa,
                           PatchTerms             &terms) const;
 
-    /**
-     * The Gram matrices, the products with μ_i ∇u_ih, the area, ∫ f_i and
-     * (on an owned cell) the hat function terms on sub-triangle @p s.
-     */
+    /** The integrals of SubTriangleData and PatchTerms on sub-triangle @p s. */
     void
     integrate_sub_triangle(const CellIterator     &cell,
                            const unsigned int      s,
@@ -309,31 +298,17 @@ namespace membranes
                            SubTriangleData        &kappa,
                            PatchTerms             &terms) const;
 
-    /**
-     * The unknowns of the half-edge a–m_e of sub-triangle @p s: in the
-     * minimization of t_ih written to @p copy, in the patch problems to
-     * @p terms (on an owned cell).
-     */
+    /** The unknowns of the half-edge a–m_e of sub-triangle @p s. */
     void
     name_half_edge(const CellIterator &cell,
                    const unsigned int  s,
                    PatchTerms         &terms,
                    LocalFluxCopy      &copy) const;
 
-    /** The copier of compute_local_fluxes(): sums of the minimization. */
+    /** The copier of the cell loop: sums of the minimization. */
     void
     add_to_minimization(const LocalFluxCopy  &copy,
                         HalfEdgeMinimization &minimization) const;
-
-    /** The minimizers: the fluxes of t_ih through the half-edges. */
-    void
-    set_half_edge_fluxes(const DoFHandler<dim>      &dof_handler,
-                         const HalfEdgeMinimization &minimization);
-
-    /** @} */
-
-    /** @name The identities (flux_reconstruction.cc) */
-    /** @{ */
 
     /**
      * Per vertex a, condensed with the hanging node constraints: meas(D_a),
@@ -352,8 +327,6 @@ namespace membranes
                    const AffineConstraints<double> &hanging_node_constraints,
                    const IndexSet                  &locally_owned_dofs,
                    const MPI_Comm                   mpi_communicator) const;
-
-    /** @} */
 
     const Discretization<dim>     &discretization;
     const ProblemData<dim>        &data;

@@ -5,27 +5,12 @@
 #include <deal.II/base/quadrature.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/fe/fe.h>
-#include <deal.II/fe/mapping.h>
 #include <membranes/dual_mesh/dual_cell_quadrature.h>
 #include <vector>
 
 namespace membranes
 {
   using namespace dealii;
-
-  /** The matrix of a DerivativeForm, for the Piola transform. */
-  template <int dim>
-  Tensor<2, dim>
-  jacobian_matrix(const DerivativeForm<1, dim, dim> &jacobian)
-  {
-    Tensor<2, dim> matrix;
-    for (unsigned int r = 0; r < dim; ++r)
-      for (unsigned int c = 0; c < dim; ++c)
-        matrix[r][c] = jacobian[r][c];
-    return matrix;
-  }
-
-
 
   /**
    * The points at which one cell's flux reconstruction needs u_ih and the
@@ -134,16 +119,6 @@ namespace membranes
     reference_flux(const unsigned int           s,
                    const std::array<double, 3> &fluxes,
                    const Point<dim>            &x) const;
-
-    /**
-     * The curl of the edge bubble 4 λ_p λ_q of edge @p l of sub-triangle
-     * @p s (p, q its ends, λ the barycentric coordinates of the reference
-     * sub-triangle) at the reference point @p x.
-     */
-    Tensor<1, dim>
-    reference_rotation(const unsigned int s,
-                       const unsigned int l,
-                       const Point<dim>  &x) const;
 
     /** The points of the dual quadrature and on the edges. */
     const SubTrianglePoints<dim> &
