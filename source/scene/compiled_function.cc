@@ -269,47 +269,12 @@ namespace membranes
 
 
   void *
-  CompiledFunctions::symbol(const std::string &name) const
+  CompiledFunctions::symbol(const std::string &kind, const unsigned int i) const
   {
-    void *address = dlsym(handle, name.c_str());
+    const std::string name    = "membranes_" + kind + "_" + std::to_string(i);
+    void             *address = dlsym(handle, name.c_str());
     if (address == nullptr)
       throw Unavailable("the compiled expressions have no '" + name + "'");
     return address;
-  }
-
-
-
-  CompiledFunctions::Value
-  CompiledFunctions::value(const unsigned int i) const
-  {
-    return reinterpret_cast<Value>(
-      symbol("membranes_value_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::Gradient
-  CompiledFunctions::gradient(const unsigned int i) const
-  {
-    return reinterpret_cast<Gradient>(
-      symbol("membranes_gradient_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::Value
-  CompiledFunctions::laplacian(const unsigned int i) const
-  {
-    return reinterpret_cast<Value>(
-      symbol("membranes_laplacian_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::GroupValues
-  CompiledFunctions::group(const unsigned int g) const
-  {
-    return reinterpret_cast<GroupValues>(
-      symbol("membranes_group_" + std::to_string(g)));
   }
 } // namespace membranes

@@ -119,19 +119,31 @@ namespace membranes
 
     /** The value of expression @p i. */
     Value
-    value(const unsigned int i) const;
+    value(const unsigned int i) const
+    {
+      return reinterpret_cast<Value>(symbol("value", i));
+    }
 
     /** The gradient of expression @p i; only if requested. */
     Gradient
-    gradient(const unsigned int i) const;
+    gradient(const unsigned int i) const
+    {
+      return reinterpret_cast<Gradient>(symbol("gradient", i));
+    }
 
     /** The Laplacian of expression @p i; only if requested. */
     Value
-    laplacian(const unsigned int i) const;
+    laplacian(const unsigned int i) const
+    {
+      return reinterpret_cast<Value>(symbol("laplacian", i));
+    }
 
     /** Group @p g. */
     GroupValues
-    group(const unsigned int g) const;
+    group(const unsigned int g) const
+    {
+      return reinterpret_cast<GroupValues>(symbol("group", g));
+    }
 
     /**
      * Whether the shared object was compiled by this run (false: found in
@@ -151,9 +163,12 @@ namespace membranes
     cache_directory();
 
   private:
-    /** The symbol @p name of the loaded object; Unavailable if absent. */
+    /**
+     * The entry point membranes_<kind>_<i> of the loaded object; Unavailable
+     * if absent.
+     */
     void *
-    symbol(const std::string &name) const;
+    symbol(const std::string &kind, const unsigned int i) const;
 
     void *handle = nullptr;
   };
