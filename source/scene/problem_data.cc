@@ -118,7 +118,8 @@ namespace membranes
    * cell), not once per point.
    */
   template <int dim>
-  class ProblemData<dim>::Expression : public Function<dim>
+  class ProblemData<dim>::Expression : public Function<dim>,
+                                       public ExpressionEntry<dim>
   {
   public:
     /**
@@ -132,9 +133,7 @@ namespace membranes
                const std::map<std::string, double> &constants,
                const std::string                   &gradient_entry      = "",
                const std::string                   &gradient_expression = "")
-      : checks(entry, expression)
-      , entry(entry)
-      , expression(expression)
+      : ExpressionEntry<dim>(entry, expression)
       , constants(constants)
       , gradient_entry(gradient_entry)
       , gradient_expression(gradient_expression)
@@ -149,7 +148,7 @@ namespace membranes
     Expression(const std::string                              &entry,
                const std::string                              &description,
                const std::function<double(const Point<dim> &)> compiled_value)
-      : checks(entry, description)
+      : ExpressionEntry<dim>(entry, description)
       , compiled_value(compiled_value)
     {}
 
@@ -166,26 +165,12 @@ namespace membranes
       compiled_gradient = gradient;
     }
 
-    /** Check @p value at @p p as value() checks its own. */
-    void
-    check(const double value, const Point<dim> &p) const
-    {
-      checks.check(value, p, "value");
-    }
-
-    /** Check @p gradient at @p p as gradient() checks its own. */
-    void
-    check(const Tensor<1, dim> &gradient, const Point<dim> &p) const
-    {
-      checks.check(gradient, p);
-    }
-
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
       const double result =
         compiled_value ? compiled_value(p) : parsers().value(p);
-      check(result, p);
+      this->check(result, p);
       return result;
     }
 
@@ -199,7 +184,7 @@ namespace membranes
         {
           values[q] =
             local ? local->value(points[q]) : compiled_value(points[q]);
-          check(values[q], points[q]);
+          this->check(values[q], points[q]);
         }
     }
 
@@ -209,7 +194,7 @@ namespace membranes
       if (!compiled_gradient)
         return parsers().gradient(p);
       const Tensor<1, dim> result = compiled_gradient(p);
-      check(result, p);
+      this->check(result, p);
       return result;
     }
 
@@ -222,7 +207,7 @@ namespace membranes
         for (unsigned int q = 0; q < points.size(); ++q)
           {
             gradients[q] = compiled_gradient(points[q]);
-            check(gradients[q], points[q]);
+            this->check(gradients[q], points[q]);
           }
       else
         {
@@ -265,13 +250,6 @@ namespace membranes
         parsers().set_h(step);
     }
 
-    /** The InputError for this entry, which should be @p allowed. */
-    Parameters::InputError
-    invalid(const std::string &allowed) const
-    {
-      return checks.invalid(allowed);
-    }
-
   private:
     /**
      * The parsers of one thread, bound to that thread's point. Without a
@@ -283,7 +261,7 @@ namespace membranes
     {
       explicit ThreadParsers(const Expression &e)
         : AutoDerivativeFunction<dim>(1e-5)
-        , function(e.entry, e.expression, 1, e.constants, point)
+        , function(e.entry, e.text, 1, e.constants, point)
       {
         if (!Utilities::trim(e.gradient_expression).empty())
           exact_gradient = std::make_unique<ParsedExpressionEntry<dim>>(
@@ -339,8 +317,6 @@ namespace membranes
       return *local;
     }
 
-    const ExpressionEntry<dim>          checks;
-    const std::string                   entry, expression;
     const std::map<std::string, double> constants;
     const std::string                   gradient_entry, gradient_expression;
     mutable Threads::ThreadLocalStorage<std::shared_ptr<ThreadParsers>>
@@ -348,29 +324,6 @@ namespace membranes
 
     std::function<double(const Point<dim> &)>         compiled_value;
     std::function<Tensor<1, dim>(const Point<dim> &)> compiled_gradient;
-  };
-
-
-
-  template <int dim>
-  class ProblemData<dim>::BoundaryValues : public Function<dim>
-  {
-  public:
-    BoundaryValues(const Function<dim> &g, const Function<dim> &g2)
-      : Function<dim>(2)
-      , g(g)
-      , g2(g2)
-    {}
-
-    double
-    value(const Point<dim> &p, const unsigned int component) const override
-    {
-      return component == 0 ? g.value(p) : g2.value(p);
-    }
-
-  private:
-    const Function<dim> &g;
-    const Function<dim> &g2;
   };
 
 
@@ -453,7 +406,10 @@ namespace membranes
         }
     if (exact.manufactured)
       manufacture(scene);
-    g_and_g2 = std::make_unique<BoundaryValues>(*g, *g2);
+    g_and_g2 = std::make_unique<FunctionFromFunctionObjects<dim>>(
+      std::vector<std::function<double(const Point<dim> &)>>{
+        [this](const Point<dim> &p) { return g->value(p); },
+        [this](const Point<dim> &p) { return g2->value(p); }});
   }
 
 

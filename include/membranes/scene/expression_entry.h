@@ -44,7 +44,9 @@ namespace membranes
      * or larger than max_magnitude in magnitude.
      */
     void
-    check(const double value, const Point<dim> &p, const char *what) const
+    check(const double      value,
+          const Point<dim> &p,
+          const char       *what = "value") const
     {
       if (!(std::abs(value) <= Parameters::max_magnitude))
         throw out_of_range(value, p, what);
@@ -61,6 +63,7 @@ namespace membranes
                  const Point<dim> &p,
                  const char       *what) const;
 
+  protected:
     const std::string entry;
     const std::string text;
   };

@@ -171,7 +171,6 @@ namespace membranes
 
   private:
     class Expression;
-    class BoundaryValues;
 
     void
     compile(
