@@ -93,29 +93,17 @@ namespace membranes
 
 
   /**
-   * The function of one expression of the scene, which checks every value
-   * it gives: one that is not finite, or larger than max_magnitude in
-   * magnitude, is an InputError naming the entry and the point. All uses
-   * of the data go through here (loads at the quadrature points of every
-   * cell, boundary values at the boundary vertices, the exact solution and
-   * its gradient in the error norms), on every mesh, so that a NaN or an
-   * infinity never enters a computation unnoticed, wherever the expression
-   * produces it.
-   *
-   * The values come from compiled code once use_compiled() has been called
-   * (CompiledFunctions), and the gradient then from its dual numbers; an
+   * The function of one expression of the scene, evaluated and checked as
+   * the class comment of ProblemData says. All uses of the data go through
+   * here, on every mesh, so that a NaN or an infinity never enters a
+   * computation unnoticed, wherever the expression produces it. An
    * expression that is only derived (the manufactured loads) has compiled
-   * values only. Otherwise muparser evaluates the expression, and the
-   * gradient is given by a second entry when the scene has one (the exact
-   * gradients of the displacements), or else it is the central difference
-   * of the expression with the step of set_gradient_step().
+   * values only.
    *
    * The loops over cells run on several threads (WorkStream). Compiled
    * code has no state; a muparser object evaluates at the point its
    * variables are bound to: so every thread has its own parsers and point,
-   * made on its first evaluation. They are found once per call of
-   * value_list() or gradient_list() (one lookup for all the points of a
-   * cell), not once per point.
+   * made on its first evaluation.
    */
   template <int dim>
   class ProblemData<dim>::Expression : public Function<dim>,
@@ -338,10 +326,9 @@ namespace membranes
     , manufactured(exact.manufactured)
   {
     const auto constants = parse_constants(problem);
-    // The expressions of the scene, each parsed (a syntax error is an
-    // InputError here, with muparser's message, however they are then
-    // evaluated), and what compiling them asks for.
-    std::vector<std::pair<Expression *, CompiledFunctions::Request>> scene;
+    // Each expression parsed (a syntax error is an InputError here, with
+    // muparser's message, however they are then evaluated).
+    Scene      scene;
     const auto add = [&](std::unique_ptr<Expression> &expression,
                          const std::string           &entry,
                          const std::string           &text,
@@ -421,10 +408,8 @@ namespace membranes
    */
   template <int dim>
   void
-  ProblemData<dim>::compile(
-    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-                                        &scene,
-    const std::map<std::string, double> &constants)
+  ProblemData<dim>::compile(const Scene                         &scene,
+                            const std::map<std::string, double> &constants)
   {
     std::map<std::string, double> all_constants = constants;
     const mu::Parser              parser;
@@ -483,9 +468,7 @@ namespace membranes
    */
   template <int dim>
   void
-  ProblemData<dim>::manufacture(
-    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-      &scene)
+  ProblemData<dim>::manufacture(const Scene &scene)
   {
     const CompiledFunctions::Value lambda =
       compiled->value(position(scene, exact_action.get()));

@@ -53,11 +53,8 @@ namespace membranes
   {
   public:
     /**
-     * The data of the scene: its expressions parsed, and compiled unless
-     * `Problem/Expression evaluation = parser` (with `auto`, when no
-     * compiler works, a one-line note on @p pcout says so and the parser
-     * evaluates them). With `Exact solution/Manufactured data` the loads
-     * and boundary heights are derived from the exact solution.
+     * The data of the scene. With `Problem/Expression evaluation = auto` and
+     * no working compiler, a one-line note on @p pcout says so.
      */
     ProblemData(const Parameters::Problem       &problem,
                 const Parameters::ExactSolution &exact,
@@ -78,7 +75,7 @@ namespace membranes
      * The loads f1, f2 at @p points, into @p values (resized to them).
      * With compiled expressions one call evaluates both together at all
      * points (with manufactured data, the Laplacians of u1 and u2 and λ
-     * they are made of), each value checked as value() checks it.
+     * they are made of).
      */
     void
     load_list(const std::vector<Point<dim>> &points, LoadValues &values) const;
@@ -91,11 +88,9 @@ namespace membranes
     boundary_values() const;
 
     /**
-     * Check g ≥ 0 and g − g2 ≥ 0 at the boundary vertices of @p triangulation
-     * and at points along every boundary face, on the boundary as its
-     * manifold describes it (where the vertices of the finer meshes, at
-     * which g_h and g2_h interpolate g and g2, will lie). Throws an
-     * InputError naming `Problem/g` or `Problem/g2` otherwise.
+     * Check g ≥ 0 and g − g2 ≥ 0 at points along every boundary face of
+     * @p triangulation; an InputError naming `Problem/g` or `Problem/g2`
+     * otherwise.
      */
     void
     check_boundary_data(const Triangulation<dim> &triangulation) const;
@@ -145,9 +140,7 @@ namespace membranes
      * @p values (resized to them); only when known. With compiled
      * expressions one call evaluates all of them together at all points
      * (CompiledFunctions::Group), so that what u1 and u2 share (u1 = u2 +
-     * a gap, say) is computed once, and the gradients come with the values
-     * from the same dual numbers. Every value is checked as value() checks
-     * it.
+     * a gap, say) is computed once.
      */
     void
     exact_solution_list(const std::vector<Point<dim>> &points,
@@ -157,7 +150,7 @@ namespace membranes
      * The exact λ alone at @p points, into @p values (resized to them);
      * only when known. For points where λ is wanted and u may be singular
      * (on the edges and at the vertices of the mesh: the slit, a re-entrant
-     * corner). Each value checked as value() checks it.
+     * corner).
      */
     void
     exact_action_list(const std::vector<Point<dim>> &points,
@@ -172,16 +165,15 @@ namespace membranes
   private:
     class Expression;
 
-    void
-    compile(
-      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-                                          &scene,
-      const std::map<std::string, double> &constants);
+    /** The expressions of the scene, and what compiling them asks for. */
+    using Scene =
+      std::vector<std::pair<Expression *, CompiledFunctions::Request>>;
 
     void
-    manufacture(
-      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-        &scene);
+    compile(const Scene &scene, const std::map<std::string, double> &constants);
+
+    void
+    manufacture(const Scene &scene);
 
     void
     check_gradient_entries(const Point<dim> &p) const;
