@@ -124,16 +124,6 @@ namespace membranes
       return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }
 
-    /** The first line of file @p name, if any. */
-    std::string
-    first_line(const std::string &name)
-    {
-      std::ifstream in(name);
-      std::string   line;
-      std::getline(in, line);
-      return line;
-    }
-
     /** Whether @p directory can be created (if needed) and written to. */
     bool
     usable(const std::filesystem::path &directory)
@@ -168,8 +158,10 @@ namespace membranes
       for (const auto &flag : compiler_flags())
         command.push_back(flag);
       command.insert(command.end(), {source_file, "-o", object});
-      const int         status  = run(command, log);
-      const std::string message = first_line(log);
+      const int     status = run(command, log);
+      std::string   message;
+      std::ifstream log_file(log);
+      std::getline(log_file, message);
       std::remove(source_file.c_str());
       std::remove(log.c_str());
       if (status != 0 || std::rename(object.c_str(), target.c_str()) != 0)

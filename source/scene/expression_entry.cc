@@ -21,16 +21,6 @@ namespace membranes
 
 
 
-  template <int dim>
-  std::vector<std::string>
-  variable_names()
-  {
-    return Utilities::split_string_list(
-      FunctionParser<dim>::default_variable_names());
-  }
-
-
-
   namespace
   {
     /**
@@ -54,7 +44,8 @@ namespace membranes
       namespace deal_ii = dealii::internal::FunctionParser;
       for (const auto &[name, value] : constants)
         parser.DefineConst(name, value);
-      const auto names = variable_names<dim>();
+      const auto names = Utilities::split_string_list(
+        FunctionParser<dim>::default_variable_names());
       for (unsigned int d = 0; d < dim; ++d)
         parser.DefineVar(names[d], &point[d]);
       parser.DefineFun("if", deal_ii::mu_if, true);
@@ -172,8 +163,6 @@ namespace membranes
 
   template std::string
   point_text(const Point<2> &);
-  template std::vector<std::string>
-  variable_names<2>();
   template class ExpressionEntry<2>;
   template class ParsedExpressionEntry<2>;
 } // namespace membranes

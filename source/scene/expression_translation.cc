@@ -119,7 +119,7 @@ namespace membranes
       std::string
       conditional()
       {
-        const std::string condition = logical_or();
+        const std::string condition = logical(&Translator::logical_and, "||");
         if (!accept("?"))
           return condition;
         const std::string if_true = ternary();
@@ -152,12 +152,6 @@ namespace membranes
             left = "truth<T>(" + test + "(" + left + ") " + op + " " + test +
                    "(" + right + "))";
           }
-      }
-
-      std::string
-      logical_or()
-      {
-        return logical(&Translator::logical_and, "||");
       }
 
       std::string

@@ -436,10 +436,12 @@ namespace membranes
                          {position(scene, exact_u[1].get()), true},
                          {position(scene, exact_action.get())}},
                         true});
-    compiled    = std::make_unique<CompiledFunctions>(requests,
-                                                   variable_names<dim>(),
-                                                   all_constants,
-                                                   groups);
+    compiled = std::make_unique<CompiledFunctions>(
+      requests,
+      Utilities::split_string_list(
+        FunctionParser<dim>::default_variable_names()),
+      all_constants,
+      groups);
     loads_group = compiled->group(0);
     if (known)
       exact_group = compiled->group(1);

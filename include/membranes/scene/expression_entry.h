@@ -19,11 +19,6 @@ namespace membranes
   std::string
   point_text(const Point<dim> &p);
 
-  /** The names of the variables of every expression: x, y. */
-  template <int dim>
-  std::vector<std::string>
-  variable_names();
-
   /**
    * An entry of the scene that holds an expression, and the checks of its
    * values: one that is not finite, or larger than Parameters::max_magnitude
