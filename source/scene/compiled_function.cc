@@ -175,46 +175,52 @@ namespace membranes
             "; set MEMBRANES_CXX to a working one");
         }
     }
+
+    /**
+     * The directory of the cached shared objects: `MEMBRANES_CACHE_DIR`,
+     * else `$XDG_CACHE_HOME/membranes`, else `$HOME/.cache/membranes`,
+     * the first that can be created and written; else a directory of this
+     * user in the system's temporary directory. Throws Unavailable if none
+     * can be.
+     */
+    std::string
+    cache_directory()
+    {
+      std::vector<std::filesystem::path> candidates;
+      if (const char *variable = std::getenv("MEMBRANES_CACHE_DIR");
+          variable != nullptr && *variable != '\0')
+        candidates.emplace_back(variable);
+      else
+        {
+          if (const char *xdg = std::getenv("XDG_CACHE_HOME");
+              xdg != nullptr && *xdg == '/')
+            candidates.emplace_back(std::filesystem::path(xdg) / "membranes");
+          if (const char *home = std::getenv("HOME");
+              home != nullptr && *home == '/')
+            candidates.emplace_back(std::filesystem::path(home) / ".cache" /
+                                    "membranes");
+        }
+      for (const auto &candidate : candidates)
+        if (usable(candidate))
+          return candidate.string();
+
+      // A directory of this user only: another user could place an object
+      // to be loaded in a directory that is not.
+      std::error_code             error;
+      const std::filesystem::path temporary =
+        std::filesystem::temp_directory_path(error) /
+        ("membranes-" + std::to_string(getuid()));
+      mkdir(temporary.c_str(), 0700);
+      struct stat status;
+      if (!error && lstat(temporary.c_str(), &status) == 0 &&
+          S_ISDIR(status.st_mode) && status.st_uid == getuid() &&
+          (status.st_mode & 022) == 0 && usable(temporary))
+        return temporary.string();
+      throw CompiledFunctions::Unavailable(
+        "no cache directory can be written (set "
+        "MEMBRANES_CACHE_DIR to one)");
+    }
   } // namespace
-
-
-
-  std::string
-  CompiledFunctions::cache_directory()
-  {
-    std::vector<std::filesystem::path> candidates;
-    if (const char *variable = std::getenv("MEMBRANES_CACHE_DIR");
-        variable != nullptr && *variable != '\0')
-      candidates.emplace_back(variable);
-    else
-      {
-        if (const char *xdg = std::getenv("XDG_CACHE_HOME");
-            xdg != nullptr && *xdg == '/')
-          candidates.emplace_back(std::filesystem::path(xdg) / "membranes");
-        if (const char *home = std::getenv("HOME");
-            home != nullptr && *home == '/')
-          candidates.emplace_back(std::filesystem::path(home) / ".cache" /
-                                  "membranes");
-      }
-    for (const auto &candidate : candidates)
-      if (usable(candidate))
-        return candidate.string();
-
-    // A directory of this user only: another user could place an object
-    // to be loaded in a directory that is not.
-    std::error_code             error;
-    const std::filesystem::path temporary =
-      std::filesystem::temp_directory_path(error) /
-      ("membranes-" + std::to_string(getuid()));
-    mkdir(temporary.c_str(), 0700);
-    struct stat status;
-    if (!error && lstat(temporary.c_str(), &status) == 0 &&
-        S_ISDIR(status.st_mode) && status.st_uid == getuid() &&
-        (status.st_mode & 022) == 0 && usable(temporary))
-      return temporary.string();
-    throw Unavailable("no cache directory can be written (set "
-                      "MEMBRANES_CACHE_DIR to one)");
-  }
 
 
 

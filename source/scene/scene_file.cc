@@ -15,11 +15,6 @@
 #include <sstream>
 #include <vector>
 
-// Reading a scene: deal.II's ParameterHandler parses it; the program's own
-// part is the guard against include cycles and error lines that say where
-// an error is in the terms of the scene (`Subsection/Entry`, the declared
-// alternatives) instead of deal.II's; and the --set assignments and the
-// record of the parameters (parameters.prm).
 namespace membranes::Parameters
 {
   using dealii::Utilities::trim;

@@ -29,9 +29,7 @@ namespace membranes
    * they are evaluated by muparser directly, set up as FunctionParser sets
    * it up (the same values to the last bit), one set of parsers per thread,
    * looked up once per list of points (a cell's quadrature points), not, as
-   * FunctionParser does, on every evaluation. Expressions are parsed by
-   * muparser and evaluated once on construction in either case; one that
-   * does not parse is an InputError naming its entry. Every value is
+   * FunctionParser does, on every evaluation. Every value is
    * checked where the program evaluates it: one that is not finite, or
    * larger than Parameters::max_magnitude in magnitude, is an InputError
    * naming the entry and the point.
