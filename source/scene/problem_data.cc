@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <deal.II/base/auto_derivative_function.h>
 #include <deal.II/base/function_parser.h>
@@ -12,6 +11,7 @@
 #include <membranes/scene/problem_data.h>
 #include <muParser.h>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <tuple>
 
@@ -36,15 +36,10 @@ namespace membranes
           double     value      = 0;
           // A name as muparser takes it, other than a variable (muparser
           // aborts the program on those).
-          bool ok =
-            (name_value.size() == 2 && !name_value[0].empty() &&
-             std::isalpha(static_cast<unsigned char>(name_value[0][0])) &&
-             std::all_of(name_value[0].begin(),
-                         name_value[0].end(),
-                         [](const unsigned char c) {
-                           return std::isalnum(c) || c == '_';
-                         }) &&
-             name_value[0] != "x" && name_value[0] != "y");
+          bool ok = name_value.size() == 2 &&
+                    std::regex_match(name_value[0],
+                                     std::regex("[A-Za-z][A-Za-z0-9_]*")) &&
+                    name_value[0] != "x" && name_value[0] != "y";
           if (ok)
             {
               std::istringstream in(name_value[1]);
