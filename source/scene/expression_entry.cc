@@ -1,4 +1,3 @@
-#include <cmath>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mu_parser_internal.h>
 #include <deal.II/base/utilities.h>
@@ -74,24 +73,6 @@ namespace membranes
       parser.SetExpr(text);
     }
   } // namespace
-
-
-
-  template <int dim>
-  ExpressionEntry<dim>::ExpressionEntry(const std::string &entry,
-                                        const std::string &text)
-    : entry(entry)
-    , text(text)
-  {}
-
-
-
-  template <int dim>
-  Parameters::InputError
-  ExpressionEntry<dim>::invalid(const std::string &allowed) const
-  {
-    return Parameters::invalid_entry(entry, text, allowed);
-  }
 
 
 

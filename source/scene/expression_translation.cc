@@ -23,10 +23,6 @@ namespace membranes
      *     power   := primary ('^' sign)?
      *     primary := number | name | name '(' ternary (',' ternary)* ')'
      *              | '(' ternary ')'
-     *
-     * The expression has been accepted by muparser before: the translator
-     * needs no error messages of its own for bad syntax, only the refusal
-     * (Unavailable) of what has no compiled form.
      */
     class Translator
     {

@@ -10,7 +10,6 @@
 #include <membranes/scene/expression_entry.h>
 #include <membranes/scene/problem_data.h>
 #include <muParser.h>
-#include <optional>
 #include <regex>
 #include <sstream>
 #include <tuple>
@@ -201,25 +200,29 @@ namespace membranes
     }
 
     /**
-     * The gradient of the scene's gradient entry and the compiled one at
-     * @p p, when there are both (else nothing): the entry is then a check
-     * of the user's own derivatives.
+     * With a compiled gradient (that of the dual numbers), a gradient entry
+     * of the scene is a check of the user's own derivatives: at @p p it
+     * must agree with them to 1e-8 relative to the larger of the two, or to
+     * 1e-8 where both are below 1.
      */
-    std::optional<std::pair<Tensor<1, dim>, Tensor<1, dim>>>
-    gradient_entry_and_compiled(const Point<dim> &p) const
+    void
+    check_gradient_entry(const Point<dim> &p) const
     {
       if (!compiled_gradient || Utilities::trim(gradient_expression).empty())
-        return {};
-      return std::pair{parsers().gradient(p), gradient(p)};
-    }
-
-    /** The InputError for the gradient entry, which should be @p allowed. */
-    Parameters::InputError
-    invalid_gradient(const std::string &allowed) const
-    {
-      return Parameters::invalid_entry(gradient_entry,
-                                       gradient_expression,
-                                       allowed);
+        return;
+      const Tensor<1, dim> entry      = parsers().gradient(p);
+      const Tensor<1, dim> derivative = gradient(p);
+      const double scale = std::max({1., entry.norm(), derivative.norm()});
+      if (!((entry - derivative).norm() <= 1e-8 * scale))
+        {
+          std::ostringstream allowed;
+          allowed << "at " << point_text(p) << " it is (" << entry
+                  << ") but the derivative of the exact solution is ("
+                  << derivative << ")";
+          throw Parameters::invalid_entry(gradient_entry,
+                                          gradient_expression,
+                                          allowed.str());
+        }
     }
 
     /**
@@ -606,35 +609,8 @@ namespace membranes
                   u->gradient(p);
                 }
               exact_action->value(p);
-              check_gradient_entries(p);
-            }
-        }
-  }
-
-
-
-  /**
-   * With compiled expressions the gradients of u1, u2 are those of their
-   * dual numbers; a gradient entry of the scene is then a check of the
-   * user's own derivatives: at @p p it must agree with them to 1e-8
-   * relative to the larger of the two, or to 1e-8 where both are below 1.
-   */
-  template <int dim>
-  void
-  ProblemData<dim>::check_gradient_entries(const Point<dim> &p) const
-  {
-    for (const auto &u : exact_u)
-      if (const auto both = u->gradient_entry_and_compiled(p))
-        {
-          const auto &[entry, derivative] = *both;
-          const double scale = std::max({1., entry.norm(), derivative.norm()});
-          if (!((entry - derivative).norm() <= 1e-8 * scale))
-            {
-              std::ostringstream allowed;
-              allowed << "at " << point_text(p) << " it is (" << entry
-                      << ") but the derivative of the exact solution is ("
-                      << derivative << ")";
-              throw u->invalid_gradient(allowed.str());
+              for (const auto &u : exact_u)
+                u->check_gradient_entry(p);
             }
         }
   }

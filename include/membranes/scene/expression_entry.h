@@ -28,11 +28,17 @@ namespace membranes
   class ExpressionEntry
   {
   public:
-    ExpressionEntry(const std::string &entry, const std::string &text);
+    ExpressionEntry(const std::string &entry, const std::string &text)
+      : entry(entry)
+      , text(text)
+    {}
 
     /** The InputError for this entry, which should be @p allowed. */
     Parameters::InputError
-    invalid(const std::string &allowed) const;
+    invalid(const std::string &allowed) const
+    {
+      return Parameters::invalid_entry(entry, text, allowed);
+    }
 
     /**
      * Throw the InputError for @p what at @p p if @p value is not finite

@@ -173,9 +173,6 @@ namespace membranes
     void
     manufacture(const Scene &scene);
 
-    void
-    check_gradient_entries(const Point<dim> &p) const;
-
     std::unique_ptr<CompiledFunctions> compiled;
 
     /**
