@@ -266,7 +266,7 @@ namespace membranes
   std::optional<ErrorRecord>
   MembraneProblem<dim>::compute_errors()
   {
-    if (!data.exact_solution_known())
+    if (!data.exact_solution_known)
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
     const auto         errors =
@@ -332,7 +332,7 @@ namespace membranes
       parameters.refinement.estimator == Parameters::Estimator::flux;
     const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
-    if (!(drives && !flux_drives) && !data.exact_solution_known() && !balanced)
+    if (!(drives && !flux_drives) && !data.exact_solution_known && !balanced)
       return {};
     TimerOutput::Scope scope(computing_timer, "estimate");
     Vector<double>     residual_indicators;
@@ -598,7 +598,7 @@ namespace membranes
     phases.estimate    = time_of("estimate");
     if (computes_fluxes())
       phases.flux = time_of("flux");
-    if (data.exact_solution_known())
+    if (data.exact_solution_known)
       phases.errors = time_of("errors");
     return phases;
   }

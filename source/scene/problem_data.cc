@@ -320,7 +320,7 @@ namespace membranes
                                 const ConditionalOStream        &pcout)
     : mu{{problem.mu1, problem.mu2}}
     , mu_bar(problem.mu1 * problem.mu2 / (problem.mu1 + problem.mu2))
-    , known(exact.known)
+    , exact_solution_known(exact.known)
     , manufactured(exact.manufactured)
   {
     const auto constants = parse_constants(problem);
@@ -346,7 +346,7 @@ namespace membranes
         add(g, "Problem/g", problem.g, false, false);
         add(g2, "Problem/g2", problem.g2, false, false);
       }
-    if (known || exact.manufactured)
+    if (exact_solution_known || exact.manufactured)
       {
         const std::array<std::string, 2> u{{exact.u1, exact.u2}};
         const std::array<std::string, 2> gradient{
@@ -429,7 +429,7 @@ namespace membranes
     else
       groups.push_back(
         {{{position(scene, f[0].get())}, {position(scene, f[1].get())}}});
-    if (known)
+    if (exact_solution_known)
       groups.push_back({{{position(scene, exact_u[0].get()), true},
                          {position(scene, exact_u[1].get()), true},
                          {position(scene, exact_action.get())}},
@@ -441,7 +441,7 @@ namespace membranes
       all_constants,
       groups);
     loads_group = compiled->group(0);
-    if (known)
+    if (exact_solution_known)
       exact_group = compiled->group(1);
     for (unsigned int i = 0; i < scene.size(); ++i)
       {
@@ -593,7 +593,7 @@ namespace membranes
     const Mapping<dim>       &mapping,
     const Quadrature<dim>    &quadrature) const
   {
-    if (!exact_solution_known())
+    if (!exact_solution_known)
       return;
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -629,20 +629,11 @@ namespace membranes
 
 
   template <int dim>
-  bool
-  ProblemData<dim>::exact_solution_known() const
-  {
-    return known;
-  }
-
-
-
-  template <int dim>
   void
   ProblemData<dim>::exact_solution_list(const std::vector<Point<dim>> &points,
                                         ExactValues &values) const
   {
-    Assert(known, ExcInternalError());
+    Assert(exact_solution_known, ExcInternalError());
     const unsigned int n_points = points.size();
     values.lambda.resize(n_points);
     for (unsigned int i = 0; i < 2; ++i)
@@ -689,7 +680,7 @@ namespace membranes
   ProblemData<dim>::exact_action_list(const std::vector<Point<dim>> &points,
                                       std::vector<double> &values) const
   {
-    Assert(known, ExcInternalError());
+    Assert(exact_solution_known, ExcInternalError());
     values.resize(points.size());
     exact_action->value_list(points, values);
   }

@@ -535,9 +535,8 @@ namespace membranes::Parameters
   {
     /**
      * The first entry of @p tree (of tree_of()) below the subsections
-     * @p path whose value a parameter file cannot hold: with a line break,
-     * a '#' (a comment starts there) or a '\\' at the end (which joins
-     * the next line); as `Subsection/Entry` and its value, empty if there
+     * @p path whose value a parameter file cannot hold (see
+     * parameter_file()), as `Subsection/Entry` and its value; empty if there
      * is none.
      */
     std::pair<std::string, std::string>

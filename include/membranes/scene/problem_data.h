@@ -105,9 +105,6 @@ namespace membranes
                          const Mapping<dim>       &mapping,
                          const Quadrature<dim>    &quadrature) const;
 
-    bool
-    exact_solution_known() const;
-
     /**
      * Set the step of the finite differences that give the gradients of the
      * exact displacements (those without a gradient entry in the scene).
@@ -160,6 +157,9 @@ namespace membranes
     /** μ̄ = μ1 μ2 / (μ1 + μ2), the tension of the obstacle problem for w. */
     const double mu_bar;
 
+    /** Whether the exact solution is known (`Exact solution/Known`). */
+    const bool exact_solution_known;
+
   private:
     class Expression;
 
@@ -192,7 +192,6 @@ namespace membranes
     std::unique_ptr<Expression>                g2;
     std::unique_ptr<Function<dim>>             g_and_g2;
 
-    const bool                                 known;
     const bool                                 manufactured;
     std::array<std::unique_ptr<Expression>, 2> exact_u;
     std::unique_ptr<Expression>                exact_action;
