@@ -266,7 +266,7 @@ namespace membranes
   std::optional<ErrorRecord>
   MembraneProblem<dim>::compute_errors()
   {
-    if (!data.exact_solution_known())
+    if (!data.exact_solution_known)
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
     ErrorRecord        errors =
@@ -318,7 +318,7 @@ namespace membranes
       parameters.refinement.estimator == Parameters::Estimator::flux;
     const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
-    if (!(drives && !flux_drives) && !data.exact_solution_known() && !balanced)
+    if (!(drives && !flux_drives) && !data.exact_solution_known && !balanced)
       return {};
     TimerOutput::Scope scope(computing_timer, "estimate");
     Vector<double>     residual_indicators;
@@ -646,7 +646,7 @@ namespace membranes
     record.times.estimate    = time_of("estimate");
     if (computes_fluxes())
       record.times.flux = time_of("flux");
-    if (data.exact_solution_known())
+    if (data.exact_solution_known)
       record.times.errors = time_of("errors");
     record.cumulative_wall_time =
       previous_record.cumulative_wall_time + record.times.method();

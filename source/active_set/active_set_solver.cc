@@ -374,9 +374,7 @@ namespace membranes
         const unsigned int linear_iterations = statistics.linear_iterations;
         {
           TimerOutput::Scope scope(timer, "assembly");
-          system->set_active_set(problem,
-                                 dof_handler,
-                                 active_set.locally_relevant(problem));
+          system->set_active_set(problem, active_set.locally_relevant(problem));
         }
         TimerOutput::Scope scope(timer, "solve");
         // The forces of the initial guess set the tolerances of the first

@@ -243,7 +243,6 @@ namespace membranes
   template <int dim>
   void
   CoupledSystem<dim>::set_active_set(const DiscreteProblem<dim> &problem,
-                                     const DoFHandler<dim>      &dof_handler,
                                      const IndexSet             &active_set)
   {
     constraints.clear();

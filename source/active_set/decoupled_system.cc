@@ -66,8 +66,7 @@ namespace membranes
   template <int dim>
   void
   DecoupledSystem<dim>::set_active_set(const DiscreteProblem<dim> &problem,
-                                       const DoFHandler<dim> &,
-                                       const IndexSet &active_set)
+                                       const IndexSet             &active_set)
   {
     // Π, 1 at the inactive vertices and 0 at the active ones, and I − Π, as
     // diagonal matrices. The matrix of W is made anew when the direct solver

@@ -124,16 +124,6 @@ namespace membranes
       return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }
 
-    /** The first line of file @p name, if any. */
-    std::string
-    first_line(const std::string &name)
-    {
-      std::ifstream in(name);
-      std::string   line;
-      std::getline(in, line);
-      return line;
-    }
-
     /** Whether @p directory can be created (if needed) and written to. */
     bool
     usable(const std::filesystem::path &directory)
@@ -168,8 +158,10 @@ namespace membranes
       for (const auto &flag : compiler_flags())
         command.push_back(flag);
       command.insert(command.end(), {source_file, "-o", object});
-      const int         status  = run(command, log);
-      const std::string message = first_line(log);
+      const int     status = run(command, log);
+      std::string   message;
+      std::ifstream log_file(log);
+      std::getline(log_file, message);
       std::remove(source_file.c_str());
       std::remove(log.c_str());
       if (status != 0 || std::rename(object.c_str(), target.c_str()) != 0)
@@ -183,46 +175,52 @@ namespace membranes
             "; set MEMBRANES_CXX to a working one");
         }
     }
+
+    /**
+     * The directory of the cached shared objects: `MEMBRANES_CACHE_DIR`,
+     * else `$XDG_CACHE_HOME/membranes`, else `$HOME/.cache/membranes`,
+     * the first that can be created and written; else a directory of this
+     * user in the system's temporary directory. Throws Unavailable if none
+     * can be.
+     */
+    std::string
+    cache_directory()
+    {
+      std::vector<std::filesystem::path> candidates;
+      if (const char *variable = std::getenv("MEMBRANES_CACHE_DIR");
+          variable != nullptr && *variable != '\0')
+        candidates.emplace_back(variable);
+      else
+        {
+          if (const char *xdg = std::getenv("XDG_CACHE_HOME");
+              xdg != nullptr && *xdg == '/')
+            candidates.emplace_back(std::filesystem::path(xdg) / "membranes");
+          if (const char *home = std::getenv("HOME");
+              home != nullptr && *home == '/')
+            candidates.emplace_back(std::filesystem::path(home) / ".cache" /
+                                    "membranes");
+        }
+      for (const auto &candidate : candidates)
+        if (usable(candidate))
+          return candidate.string();
+
+      // A directory of this user only: another user could place an object
+      // to be loaded in a directory that is not.
+      std::error_code             error;
+      const std::filesystem::path temporary =
+        std::filesystem::temp_directory_path(error) /
+        ("membranes-" + std::to_string(getuid()));
+      mkdir(temporary.c_str(), 0700);
+      struct stat status;
+      if (!error && lstat(temporary.c_str(), &status) == 0 &&
+          S_ISDIR(status.st_mode) && status.st_uid == getuid() &&
+          (status.st_mode & 022) == 0 && usable(temporary))
+        return temporary.string();
+      throw CompiledFunctions::Unavailable(
+        "no cache directory can be written (set "
+        "MEMBRANES_CACHE_DIR to one)");
+    }
   } // namespace
-
-
-
-  std::string
-  CompiledFunctions::cache_directory()
-  {
-    std::vector<std::filesystem::path> candidates;
-    if (const char *variable = std::getenv("MEMBRANES_CACHE_DIR");
-        variable != nullptr && *variable != '\0')
-      candidates.emplace_back(variable);
-    else
-      {
-        if (const char *xdg = std::getenv("XDG_CACHE_HOME");
-            xdg != nullptr && *xdg == '/')
-          candidates.emplace_back(std::filesystem::path(xdg) / "membranes");
-        if (const char *home = std::getenv("HOME");
-            home != nullptr && *home == '/')
-          candidates.emplace_back(std::filesystem::path(home) / ".cache" /
-                                  "membranes");
-      }
-    for (const auto &candidate : candidates)
-      if (usable(candidate))
-        return candidate.string();
-
-    // A directory of this user only: another user could place an object
-    // to be loaded in a directory that is not.
-    std::error_code             error;
-    const std::filesystem::path temporary =
-      std::filesystem::temp_directory_path(error) /
-      ("membranes-" + std::to_string(getuid()));
-    mkdir(temporary.c_str(), 0700);
-    struct stat status;
-    if (!error && lstat(temporary.c_str(), &status) == 0 &&
-        S_ISDIR(status.st_mode) && status.st_uid == getuid() &&
-        (status.st_mode & 022) == 0 && usable(temporary))
-      return temporary.string();
-    throw Unavailable("no cache directory can be written (set "
-                      "MEMBRANES_CACHE_DIR to one)");
-  }
 
 
 
@@ -269,47 +267,12 @@ namespace membranes
 
 
   void *
-  CompiledFunctions::symbol(const std::string &name) const
+  CompiledFunctions::symbol(const std::string &kind, const unsigned int i) const
   {
-    void *address = dlsym(handle, name.c_str());
+    const std::string name    = "membranes_" + kind + "_" + std::to_string(i);
+    void             *address = dlsym(handle, name.c_str());
     if (address == nullptr)
       throw Unavailable("the compiled expressions have no '" + name + "'");
     return address;
-  }
-
-
-
-  CompiledFunctions::Value
-  CompiledFunctions::value(const unsigned int i) const
-  {
-    return reinterpret_cast<Value>(
-      symbol("membranes_value_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::Gradient
-  CompiledFunctions::gradient(const unsigned int i) const
-  {
-    return reinterpret_cast<Gradient>(
-      symbol("membranes_gradient_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::Value
-  CompiledFunctions::laplacian(const unsigned int i) const
-  {
-    return reinterpret_cast<Value>(
-      symbol("membranes_laplacian_" + std::to_string(i)));
-  }
-
-
-
-  CompiledFunctions::GroupValues
-  CompiledFunctions::group(const unsigned int g) const
-  {
-    return reinterpret_cast<GroupValues>(
-      symbol("membranes_group_" + std::to_string(g)));
   }
 } // namespace membranes

@@ -1,4 +1,3 @@
-#include <cmath>
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mu_parser_internal.h>
 #include <deal.II/base/utilities.h>
@@ -17,16 +16,6 @@ namespace membranes
       text << (d > 0 ? ", " : "") << p[d];
     text << ")";
     return text.str();
-  }
-
-
-
-  template <int dim>
-  std::vector<std::string>
-  variable_names()
-  {
-    return Utilities::split_string_list(
-      FunctionParser<dim>::default_variable_names());
   }
 
 
@@ -54,7 +43,8 @@ namespace membranes
       namespace deal_ii = dealii::internal::FunctionParser;
       for (const auto &[name, value] : constants)
         parser.DefineConst(name, value);
-      const auto names = variable_names<dim>();
+      const auto names = Utilities::split_string_list(
+        FunctionParser<dim>::default_variable_names());
       for (unsigned int d = 0; d < dim; ++d)
         parser.DefineVar(names[d], &point[d]);
       parser.DefineFun("if", deal_ii::mu_if, true);
@@ -83,24 +73,6 @@ namespace membranes
       parser.SetExpr(text);
     }
   } // namespace
-
-
-
-  template <int dim>
-  ExpressionEntry<dim>::ExpressionEntry(const std::string &entry,
-                                        const std::string &text)
-    : entry(entry)
-    , text(text)
-  {}
-
-
-
-  template <int dim>
-  Parameters::InputError
-  ExpressionEntry<dim>::invalid(const std::string &allowed) const
-  {
-    return Parameters::invalid_entry(entry, text, allowed);
-  }
 
 
 
@@ -172,8 +144,6 @@ namespace membranes
 
   template std::string
   point_text(const Point<2> &);
-  template std::vector<std::string>
-  variable_names<2>();
   template class ExpressionEntry<2>;
   template class ParsedExpressionEntry<2>;
 } // namespace membranes

@@ -23,10 +23,6 @@ namespace membranes
      *     power   := primary ('^' sign)?
      *     primary := number | name | name '(' ternary (',' ternary)* ')'
      *              | '(' ternary ')'
-     *
-     * The expression has been accepted by muparser before: the translator
-     * needs no error messages of its own for bad syntax, only the refusal
-     * (Unavailable) of what has no compiled form.
      */
     class Translator
     {
@@ -119,7 +115,7 @@ namespace membranes
       std::string
       conditional()
       {
-        const std::string condition = logical_or();
+        const std::string condition = logical(&Translator::logical_and, "||");
         if (!accept("?"))
           return condition;
         const std::string if_true = ternary();
@@ -152,12 +148,6 @@ namespace membranes
             left = "truth<T>(" + test + "(" + left + ") " + op + " " + test +
                    "(" + right + "))";
           }
-      }
-
-      std::string
-      logical_or()
-      {
-        return logical(&Translator::logical_and, "||");
       }
 
       std::string

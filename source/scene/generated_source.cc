@@ -64,38 +64,21 @@ namespace
         r.d[i] = -a.d[i];
       return r;
     }
-    friend MEMBRANES_INLINE Dual operator+(const Dual &a, const Dual &b)
-    {
-      Dual r;
-      r.v = a.v + b.v;
-      for (int i = 0; i < n; ++i)
-        r.d[i] = a.d[i] + b.d[i];
-      return r;
+    // r = a op b, and its derivatives dr (which may use r.v).
+#define MEMBRANES_BINARY(op, dr)                                         \
+    friend MEMBRANES_INLINE Dual operator op(const Dual &a, const Dual &b) \
+    {                                                                    \
+      Dual r;                                                            \
+      r.v = a.v op b.v;                                                  \
+      for (int i = 0; i < n; ++i)                                        \
+        r.d[i] = dr;                                                     \
+      return r;                                                          \
     }
-    friend MEMBRANES_INLINE Dual operator-(const Dual &a, const Dual &b)
-    {
-      Dual r;
-      r.v = a.v - b.v;
-      for (int i = 0; i < n; ++i)
-        r.d[i] = a.d[i] - b.d[i];
-      return r;
-    }
-    friend MEMBRANES_INLINE Dual operator*(const Dual &a, const Dual &b)
-    {
-      Dual r;
-      r.v = a.v * b.v;
-      for (int i = 0; i < n; ++i)
-        r.d[i] = a.d[i] * b.v + a.v * b.d[i];
-      return r;
-    }
-    friend MEMBRANES_INLINE Dual operator/(const Dual &a, const Dual &b)
-    {
-      Dual r;
-      r.v = a.v / b.v;
-      for (int i = 0; i < n; ++i)
-        r.d[i] = (a.d[i] - r.v * b.d[i]) / b.v;
-      return r;
-    }
+    MEMBRANES_BINARY(+, a.d[i] + b.d[i])
+    MEMBRANES_BINARY(-, a.d[i] - b.d[i])
+    MEMBRANES_BINARY(*, a.d[i] * b.v + a.v * b.d[i])
+    MEMBRANES_BINARY(/, (a.d[i] - r.v * b.d[i]) / b.v)
+#undef MEMBRANES_BINARY
     T v;
     T d[n];
   };

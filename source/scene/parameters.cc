@@ -1,4 +1,3 @@
-#include <cmath>
 #include <deal.II/base/utilities.h>
 #include <membranes/scene/parameters.h>
 #include <sstream>

@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <deal.II/base/auto_derivative_function.h>
 #include <deal.II/base/function_parser.h>
@@ -11,7 +10,7 @@
 #include <membranes/scene/expression_entry.h>
 #include <membranes/scene/problem_data.h>
 #include <muParser.h>
-#include <optional>
+#include <regex>
 #include <sstream>
 #include <tuple>
 
@@ -36,15 +35,10 @@ namespace membranes
           double     value      = 0;
           // A name as muparser takes it, other than a variable (muparser
           // aborts the program on those).
-          bool ok =
-            (name_value.size() == 2 && !name_value[0].empty() &&
-             std::isalpha(static_cast<unsigned char>(name_value[0][0])) &&
-             std::all_of(name_value[0].begin(),
-                         name_value[0].end(),
-                         [](const unsigned char c) {
-                           return std::isalnum(c) || c == '_';
-                         }) &&
-             name_value[0] != "x" && name_value[0] != "y");
+          bool ok = name_value.size() == 2 &&
+                    std::regex_match(name_value[0],
+                                     std::regex("[A-Za-z][A-Za-z0-9_]*")) &&
+                    name_value[0] != "x" && name_value[0] != "y";
           if (ok)
             {
               std::istringstream in(name_value[1]);
@@ -93,32 +87,21 @@ namespace membranes
 
 
   /**
-   * The function of one expression of the scene, which checks every value
-   * it gives: one that is not finite, or larger than max_magnitude in
-   * magnitude, is an InputError naming the entry and the point. All uses
-   * of the data go through here (loads at the quadrature points of every
-   * cell, boundary values at the boundary vertices, the exact solution and
-   * its gradient in the error norms), on every mesh, so that a NaN or an
-   * infinity never enters a computation unnoticed, wherever the expression
-   * produces it.
-   *
-   * The values come from compiled code once use_compiled() has been called
-   * (CompiledFunctions), and the gradient then from its dual numbers; an
+   * The function of one expression of the scene, evaluated and checked as
+   * the class comment of ProblemData says. All uses of the data go through
+   * here, on every mesh, so that a NaN or an infinity never enters a
+   * computation unnoticed, wherever the expression produces it. An
    * expression that is only derived (the manufactured loads) has compiled
-   * values only. Otherwise muparser evaluates the expression, and the
-   * gradient is given by a second entry when the scene has one (the exact
-   * gradients of the displacements), or else it is the central difference
-   * of the expression with the step of set_gradient_step().
+   * values only.
    *
    * The loops over cells run on several threads (WorkStream). Compiled
    * code has no state; a muparser object evaluates at the point its
    * variables are bound to: so every thread has its own parsers and point,
-   * made on its first evaluation. They are found once per call of
-   * value_list() or gradient_list() (one lookup for all the points of a
-   * cell), not once per point.
+   * made on its first evaluation.
    */
   template <int dim>
-  class ProblemData<dim>::Expression : public Function<dim>
+  class ProblemData<dim>::Expression : public Function<dim>,
+                                       public ExpressionEntry<dim>
   {
   public:
     /**
@@ -132,9 +115,7 @@ namespace membranes
                const std::map<std::string, double> &constants,
                const std::string                   &gradient_entry      = "",
                const std::string                   &gradient_expression = "")
-      : checks(entry, expression)
-      , entry(entry)
-      , expression(expression)
+      : ExpressionEntry<dim>(entry, expression)
       , constants(constants)
       , gradient_entry(gradient_entry)
       , gradient_expression(gradient_expression)
@@ -149,7 +130,7 @@ namespace membranes
     Expression(const std::string                              &entry,
                const std::string                              &description,
                const std::function<double(const Point<dim> &)> compiled_value)
-      : checks(entry, description)
+      : ExpressionEntry<dim>(entry, description)
       , compiled_value(compiled_value)
     {}
 
@@ -166,26 +147,12 @@ namespace membranes
       compiled_gradient = gradient;
     }
 
-    /** Check @p value at @p p as value() checks its own. */
-    void
-    check(const double value, const Point<dim> &p) const
-    {
-      checks.check(value, p, "value");
-    }
-
-    /** Check @p gradient at @p p as gradient() checks its own. */
-    void
-    check(const Tensor<1, dim> &gradient, const Point<dim> &p) const
-    {
-      checks.check(gradient, p);
-    }
-
     double
     value(const Point<dim> &p, const unsigned int = 0) const override
     {
       const double result =
         compiled_value ? compiled_value(p) : parsers().value(p);
-      check(result, p);
+      this->check(result, p);
       return result;
     }
 
@@ -199,7 +166,7 @@ namespace membranes
         {
           values[q] =
             local ? local->value(points[q]) : compiled_value(points[q]);
-          check(values[q], points[q]);
+          this->check(values[q], points[q]);
         }
     }
 
@@ -209,7 +176,7 @@ namespace membranes
       if (!compiled_gradient)
         return parsers().gradient(p);
       const Tensor<1, dim> result = compiled_gradient(p);
-      check(result, p);
+      this->check(result, p);
       return result;
     }
 
@@ -222,7 +189,7 @@ namespace membranes
         for (unsigned int q = 0; q < points.size(); ++q)
           {
             gradients[q] = compiled_gradient(points[q]);
-            check(gradients[q], points[q]);
+            this->check(gradients[q], points[q]);
           }
       else
         {
@@ -233,25 +200,29 @@ namespace membranes
     }
 
     /**
-     * The gradient of the scene's gradient entry and the compiled one at
-     * @p p, when there are both (else nothing): the entry is then a check
-     * of the user's own derivatives.
+     * With a compiled gradient (that of the dual numbers), a gradient entry
+     * of the scene is a check of the user's own derivatives: at @p p it
+     * must agree with them to 1e-8 relative to the larger of the two, or to
+     * 1e-8 where both are below 1.
      */
-    std::optional<std::pair<Tensor<1, dim>, Tensor<1, dim>>>
-    gradient_entry_and_compiled(const Point<dim> &p) const
+    void
+    check_gradient_entry(const Point<dim> &p) const
     {
       if (!compiled_gradient || Utilities::trim(gradient_expression).empty())
-        return {};
-      return std::pair{parsers().gradient(p), gradient(p)};
-    }
-
-    /** The InputError for the gradient entry, which should be @p allowed. */
-    Parameters::InputError
-    invalid_gradient(const std::string &allowed) const
-    {
-      return Parameters::invalid_entry(gradient_entry,
-                                       gradient_expression,
-                                       allowed);
+        return;
+      const Tensor<1, dim> entry      = parsers().gradient(p);
+      const Tensor<1, dim> derivative = gradient(p);
+      const double scale = std::max({1., entry.norm(), derivative.norm()});
+      if (!((entry - derivative).norm() <= 1e-8 * scale))
+        {
+          std::ostringstream allowed;
+          allowed << "at " << point_text(p) << " it is (" << entry
+                  << ") but the derivative of the exact solution is ("
+                  << derivative << ")";
+          throw Parameters::invalid_entry(gradient_entry,
+                                          gradient_expression,
+                                          allowed.str());
+        }
     }
 
     /**
@@ -265,13 +236,6 @@ namespace membranes
         parsers().set_h(step);
     }
 
-    /** The InputError for this entry, which should be @p allowed. */
-    Parameters::InputError
-    invalid(const std::string &allowed) const
-    {
-      return checks.invalid(allowed);
-    }
-
   private:
     /**
      * The parsers of one thread, bound to that thread's point. Without a
@@ -283,7 +247,7 @@ namespace membranes
     {
       explicit ThreadParsers(const Expression &e)
         : AutoDerivativeFunction<dim>(1e-5)
-        , function(e.entry, e.expression, 1, e.constants, point)
+        , function(e.entry, e.text, 1, e.constants, point)
       {
         if (!Utilities::trim(e.gradient_expression).empty())
           exact_gradient = std::make_unique<ParsedExpressionEntry<dim>>(
@@ -339,8 +303,6 @@ namespace membranes
       return *local;
     }
 
-    const ExpressionEntry<dim>          checks;
-    const std::string                   entry, expression;
     const std::map<std::string, double> constants;
     const std::string                   gradient_entry, gradient_expression;
     mutable Threads::ThreadLocalStorage<std::shared_ptr<ThreadParsers>>
@@ -353,42 +315,18 @@ namespace membranes
 
 
   template <int dim>
-  class ProblemData<dim>::BoundaryValues : public Function<dim>
-  {
-  public:
-    BoundaryValues(const Function<dim> &g, const Function<dim> &g2)
-      : Function<dim>(2)
-      , g(g)
-      , g2(g2)
-    {}
-
-    double
-    value(const Point<dim> &p, const unsigned int component) const override
-    {
-      return component == 0 ? g.value(p) : g2.value(p);
-    }
-
-  private:
-    const Function<dim> &g;
-    const Function<dim> &g2;
-  };
-
-
-
-  template <int dim>
   ProblemData<dim>::ProblemData(const Parameters::Problem       &problem,
                                 const Parameters::ExactSolution &exact,
                                 const ConditionalOStream        &pcout)
     : mu{{problem.mu1, problem.mu2}}
     , mu_bar(problem.mu1 * problem.mu2 / (problem.mu1 + problem.mu2))
-    , known(exact.known)
+    , exact_solution_known(exact.known)
     , manufactured(exact.manufactured)
   {
     const auto constants = parse_constants(problem);
-    // The expressions of the scene, each parsed (a syntax error is an
-    // InputError here, with muparser's message, however they are then
-    // evaluated), and what compiling them asks for.
-    std::vector<std::pair<Expression *, CompiledFunctions::Request>> scene;
+    // Each expression parsed (a syntax error is an InputError here, with
+    // muparser's message, however they are then evaluated).
+    Scene      scene;
     const auto add = [&](std::unique_ptr<Expression> &expression,
                          const std::string           &entry,
                          const std::string           &text,
@@ -408,7 +346,7 @@ namespace membranes
         add(g, "Problem/g", problem.g, false, false);
         add(g2, "Problem/g2", problem.g2, false, false);
       }
-    if (known || exact.manufactured)
+    if (exact_solution_known || exact.manufactured)
       {
         const std::array<std::string, 2> u{{exact.u1, exact.u2}};
         const std::array<std::string, 2> gradient{
@@ -453,7 +391,10 @@ namespace membranes
         }
     if (exact.manufactured)
       manufacture(scene);
-    g_and_g2 = std::make_unique<BoundaryValues>(*g, *g2);
+    g_and_g2 = std::make_unique<FunctionFromFunctionObjects<dim>>(
+      std::vector<std::function<double(const Point<dim> &)>>{
+        [this](const Point<dim> &p) { return g->value(p); },
+        [this](const Point<dim> &p) { return g2->value(p); }});
   }
 
 
@@ -465,10 +406,8 @@ namespace membranes
    */
   template <int dim>
   void
-  ProblemData<dim>::compile(
-    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-                                        &scene,
-    const std::map<std::string, double> &constants)
+  ProblemData<dim>::compile(const Scene                         &scene,
+                            const std::map<std::string, double> &constants)
   {
     std::map<std::string, double> all_constants = constants;
     const mu::Parser              parser;
@@ -490,17 +429,19 @@ namespace membranes
     else
       groups.push_back(
         {{{position(scene, f[0].get())}, {position(scene, f[1].get())}}});
-    if (known)
+    if (exact_solution_known)
       groups.push_back({{{position(scene, exact_u[0].get()), true},
                          {position(scene, exact_u[1].get()), true},
                          {position(scene, exact_action.get())}},
                         true});
-    compiled    = std::make_unique<CompiledFunctions>(requests,
-                                                   variable_names<dim>(),
-                                                   all_constants,
-                                                   groups);
+    compiled = std::make_unique<CompiledFunctions>(
+      requests,
+      Utilities::split_string_list(
+        FunctionParser<dim>::default_variable_names()),
+      all_constants,
+      groups);
     loads_group = compiled->group(0);
-    if (known)
+    if (exact_solution_known)
       exact_group = compiled->group(1);
     for (unsigned int i = 0; i < scene.size(); ++i)
       {
@@ -527,9 +468,7 @@ namespace membranes
    */
   template <int dim>
   void
-  ProblemData<dim>::manufacture(
-    const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-      &scene)
+  ProblemData<dim>::manufacture(const Scene &scene)
   {
     const CompiledFunctions::Value lambda =
       compiled->value(position(scene, exact_action.get()));
@@ -654,7 +593,7 @@ namespace membranes
     const Mapping<dim>       &mapping,
     const Quadrature<dim>    &quadrature) const
   {
-    if (!exact_solution_known())
+    if (!exact_solution_known)
       return;
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -670,35 +609,8 @@ namespace membranes
                   u->gradient(p);
                 }
               exact_action->value(p);
-              check_gradient_entries(p);
-            }
-        }
-  }
-
-
-
-  /**
-   * With compiled expressions the gradients of u1, u2 are those of their
-   * dual numbers; a gradient entry of the scene is then a check of the
-   * user's own derivatives: at @p p it must agree with them to 1e-8
-   * relative to the larger of the two, or to 1e-8 where both are below 1.
-   */
-  template <int dim>
-  void
-  ProblemData<dim>::check_gradient_entries(const Point<dim> &p) const
-  {
-    for (const auto &u : exact_u)
-      if (const auto both = u->gradient_entry_and_compiled(p))
-        {
-          const auto &[entry, derivative] = *both;
-          const double scale = std::max({1., entry.norm(), derivative.norm()});
-          if (!((entry - derivative).norm() <= 1e-8 * scale))
-            {
-              std::ostringstream allowed;
-              allowed << "at " << point_text(p) << " it is (" << entry
-                      << ") but the derivative of the exact solution is ("
-                      << derivative << ")";
-              throw u->invalid_gradient(allowed.str());
+              for (const auto &u : exact_u)
+                u->check_gradient_entry(p);
             }
         }
   }
@@ -717,20 +629,11 @@ namespace membranes
 
 
   template <int dim>
-  bool
-  ProblemData<dim>::exact_solution_known() const
-  {
-    return known;
-  }
-
-
-
-  template <int dim>
   void
   ProblemData<dim>::exact_solution_list(const std::vector<Point<dim>> &points,
                                         ExactValues &values) const
   {
-    Assert(known, ExcInternalError());
+    Assert(exact_solution_known, ExcInternalError());
     const unsigned int n_points = points.size();
     values.lambda.resize(n_points);
     for (unsigned int i = 0; i < 2; ++i)
@@ -777,7 +680,7 @@ namespace membranes
   ProblemData<dim>::exact_action_list(const std::vector<Point<dim>> &points,
                                       std::vector<double> &values) const
   {
-    Assert(known, ExcInternalError());
+    Assert(exact_solution_known, ExcInternalError());
     values.resize(points.size());
     exact_action->value_list(points, values);
   }

@@ -15,11 +15,6 @@
 #include <sstream>
 #include <vector>
 
-// Reading a scene: deal.II's ParameterHandler parses it; the program's own
-// part is the guard against include cycles and error lines that say where
-// an error is in the terms of the scene (`Subsection/Entry`, the declared
-// alternatives) instead of deal.II's; and the --set assignments and the
-// record of the parameters (parameters.prm).
 namespace membranes::Parameters
 {
   using dealii::Utilities::trim;
@@ -540,9 +535,8 @@ namespace membranes::Parameters
   {
     /**
      * The first entry of @p tree (of tree_of()) below the subsections
-     * @p path whose value a parameter file cannot hold: with a line break,
-     * a '#' (a comment starts there) or a '\\' at the end (which joins
-     * the next line); as `Subsection/Entry` and its value, empty if there
+     * @p path whose value a parameter file cannot hold (see
+     * parameter_file()), as `Subsection/Entry` and its value; empty if there
      * is none.
      */
     std::pair<std::string, std::string>

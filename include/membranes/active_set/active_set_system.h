@@ -61,7 +61,7 @@ namespace membranes
      * Impose @p active_set (DoFs of the active locally relevant vertices,
      * ActiveSet::locally_relevant(), so that every process knows the
      * constraints of the cells it assembles) on the linear problem on the
-     * mesh of @p problem and @p dof_handler: here, not in solve().
+     * mesh of @p problem: here, not in solve().
      * CoupledSystem merges its contact lines u1(a) = u2(a) into
      * AffineConstraints and assembles the condensed system; DecoupledSystem
      * imposes W_a = 0 as the projection Π of the operator of W, and
@@ -70,7 +70,6 @@ namespace membranes
      */
     virtual void
     set_active_set(const DiscreteProblem<dim> &problem,
-                   const DoFHandler<dim>      &dof_handler,
                    const IndexSet             &active_set) = 0;
 
     /**

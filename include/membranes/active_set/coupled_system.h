@@ -68,7 +68,6 @@ namespace membranes
      */
     void
     set_active_set(const DiscreteProblem<dim> &problem,
-                   const DoFHandler<dim>      &dof_handler,
                    const IndexSet             &active_set) override;
 
     void

@@ -10,12 +10,11 @@ namespace membranes
 {
   /**
    * The expressions of a scene as machine code. Each expression, in the
-   * grammar of muparser as deal.II's FunctionParser sets it up (operators
-   * `?:`, `||`, `&&`, `|`, `&`, comparisons, `+ - * / ^` and signs; the
-   * functions of muparser and those deal.II adds; the variables and the
-   * constants), is translated into a C++ function template of its variables,
-   * compiled into a shared object with the C++ compiler that built the
-   * program, and loaded with dlopen.
+   * grammar of muparser as deal.II's FunctionParser sets it up, is
+   * translated into a C++ function template of its variables
+   * (translate_expression()), compiled into a shared object with the C++
+   * compiler that built the program, or the command in the environment
+   * variable `MEMBRANES_CXX` when set, and loaded with dlopen.
    *
    * The template is instantiated for double (the values), and for
    * forward-mode dual numbers: one level for the gradient, two nested levels
@@ -28,14 +27,9 @@ namespace membranes
    * compiler computes their common subexpressions once (cos(πx/2) of both
    * u1 and u2, say) and a list of points costs one call.
    *
-   * The shared object is cached under cache_directory(), named by a hash of
-   * the generated source and of the compiler: a later run with the same
-   * expressions loads it without compiling. It is written under a temporary
-   * name and renamed, so that runs side by side (tests, MPI processes)
-   * never load a half-written file.
-   *
-   * The compiler is the one that built the program, or the command in the
-   * environment variable `MEMBRANES_CXX` when set.
+   * The shared object is cached (under `MEMBRANES_CACHE_DIR` if set), named by
+   * a hash of the generated source and of the compiler: a later run with the
+   * same expressions loads it without compiling.
    */
   class CompiledFunctions
   {
@@ -119,19 +113,31 @@ namespace membranes
 
     /** The value of expression @p i. */
     Value
-    value(const unsigned int i) const;
+    value(const unsigned int i) const
+    {
+      return reinterpret_cast<Value>(symbol("value", i));
+    }
 
     /** The gradient of expression @p i; only if requested. */
     Gradient
-    gradient(const unsigned int i) const;
+    gradient(const unsigned int i) const
+    {
+      return reinterpret_cast<Gradient>(symbol("gradient", i));
+    }
 
     /** The Laplacian of expression @p i; only if requested. */
     Value
-    laplacian(const unsigned int i) const;
+    laplacian(const unsigned int i) const
+    {
+      return reinterpret_cast<Value>(symbol("laplacian", i));
+    }
 
     /** Group @p g. */
     GroupValues
-    group(const unsigned int g) const;
+    group(const unsigned int g) const
+    {
+      return reinterpret_cast<GroupValues>(symbol("group", g));
+    }
 
     /**
      * Whether the shared object was compiled by this run (false: found in
@@ -140,20 +146,10 @@ namespace membranes
     bool   compiled_now = false;
     double seconds      = 0;
 
-    /**
-     * The directory of the cached shared objects: `MEMBRANES_CACHE_DIR`,
-     * else `$XDG_CACHE_HOME/membranes`, else `$HOME/.cache/membranes`,
-     * the first that can be created and written; else a directory of this
-     * user in the system's temporary directory. Throws Unavailable if none
-     * can be.
-     */
-    static std::string
-    cache_directory();
-
   private:
-    /** The symbol @p name of the loaded object; Unavailable if absent. */
+    /** The entry point membranes_<kind>_<i>; Unavailable if absent. */
     void *
-    symbol(const std::string &name) const;
+    symbol(const std::string &kind, const unsigned int i) const;
 
     void *handle = nullptr;
   };

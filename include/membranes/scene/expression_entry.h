@@ -19,11 +19,6 @@ namespace membranes
   std::string
   point_text(const Point<dim> &p);
 
-  /** The names of the variables of every expression: x, y. */
-  template <int dim>
-  std::vector<std::string>
-  variable_names();
-
   /**
    * An entry of the scene that holds an expression, and the checks of its
    * values: one that is not finite, or larger than Parameters::max_magnitude
@@ -33,18 +28,26 @@ namespace membranes
   class ExpressionEntry
   {
   public:
-    ExpressionEntry(const std::string &entry, const std::string &text);
+    ExpressionEntry(const std::string &entry, const std::string &text)
+      : entry(entry)
+      , text(text)
+    {}
 
     /** The InputError for this entry, which should be @p allowed. */
     Parameters::InputError
-    invalid(const std::string &allowed) const;
+    invalid(const std::string &allowed) const
+    {
+      return Parameters::invalid_entry(entry, text, allowed);
+    }
 
     /**
      * Throw the InputError for @p what at @p p if @p value is not finite
      * or larger than max_magnitude in magnitude.
      */
     void
-    check(const double value, const Point<dim> &p, const char *what) const
+    check(const double      value,
+          const Point<dim> &p,
+          const char       *what = "value") const
     {
       if (!(std::abs(value) <= Parameters::max_magnitude))
         throw out_of_range(value, p, what);
@@ -61,6 +64,7 @@ namespace membranes
                  const Point<dim> &p,
                  const char       *what) const;
 
+  protected:
     const std::string entry;
     const std::string text;
   };

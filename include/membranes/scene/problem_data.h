@@ -29,9 +29,7 @@ namespace membranes
    * they are evaluated by muparser directly, set up as FunctionParser sets
    * it up (the same values to the last bit), one set of parsers per thread,
    * looked up once per list of points (a cell's quadrature points), not, as
-   * FunctionParser does, on every evaluation. Expressions are parsed by
-   * muparser and evaluated once on construction in either case; one that
-   * does not parse is an InputError naming its entry. Every value is
+   * FunctionParser does, on every evaluation. Every value is
    * checked where the program evaluates it: one that is not finite, or
    * larger than Parameters::max_magnitude in magnitude, is an InputError
    * naming the entry and the point.
@@ -53,11 +51,8 @@ namespace membranes
   {
   public:
     /**
-     * The data of the scene: its expressions parsed, and compiled unless
-     * `Problem/Expression evaluation = parser` (with `auto`, when no
-     * compiler works, a one-line note on @p pcout says so and the parser
-     * evaluates them). With `Exact solution/Manufactured data` the loads
-     * and boundary heights are derived from the exact solution.
+     * The data of the scene. With `Problem/Expression evaluation = auto` and
+     * no working compiler, a one-line note on @p pcout says so.
      */
     ProblemData(const Parameters::Problem       &problem,
                 const Parameters::ExactSolution &exact,
@@ -78,7 +73,7 @@ namespace membranes
      * The loads f1, f2 at @p points, into @p values (resized to them).
      * With compiled expressions one call evaluates both together at all
      * points (with manufactured data, the Laplacians of u1 and u2 and λ
-     * they are made of), each value checked as value() checks it.
+     * they are made of).
      */
     void
     load_list(const std::vector<Point<dim>> &points, LoadValues &values) const;
@@ -91,11 +86,9 @@ namespace membranes
     boundary_values() const;
 
     /**
-     * Check g ≥ 0 and g − g2 ≥ 0 at the boundary vertices of @p triangulation
-     * and at points along every boundary face, on the boundary as its
-     * manifold describes it (where the vertices of the finer meshes, at
-     * which g_h and g2_h interpolate g and g2, will lie). Throws an
-     * InputError naming `Problem/g` or `Problem/g2` otherwise.
+     * Check g ≥ 0 and g − g2 ≥ 0 at points along every boundary face of
+     * @p triangulation; an InputError naming `Problem/g` or `Problem/g2`
+     * otherwise.
      */
     void
     check_boundary_data(const Triangulation<dim> &triangulation) const;
@@ -111,9 +104,6 @@ namespace membranes
     check_exact_solution(const Triangulation<dim> &triangulation,
                          const Mapping<dim>       &mapping,
                          const Quadrature<dim>    &quadrature) const;
-
-    bool
-    exact_solution_known() const;
 
     /**
      * Set the step of the finite differences that give the gradients of the
@@ -145,9 +135,7 @@ namespace membranes
      * @p values (resized to them); only when known. With compiled
      * expressions one call evaluates all of them together at all points
      * (CompiledFunctions::Group), so that what u1 and u2 share (u1 = u2 +
-     * a gap, say) is computed once, and the gradients come with the values
-     * from the same dual numbers. Every value is checked as value() checks
-     * it.
+     * a gap, say) is computed once.
      */
     void
     exact_solution_list(const std::vector<Point<dim>> &points,
@@ -157,7 +145,7 @@ namespace membranes
      * The exact λ alone at @p points, into @p values (resized to them);
      * only when known. For points where λ is wanted and u may be singular
      * (on the edges and at the vertices of the mesh: the slit, a re-entrant
-     * corner). Each value checked as value() checks it.
+     * corner).
      */
     void
     exact_action_list(const std::vector<Point<dim>> &points,
@@ -169,23 +157,21 @@ namespace membranes
     /** μ̄ = μ1 μ2 / (μ1 + μ2), the tension of the obstacle problem for w. */
     const double mu_bar;
 
+    /** Whether the exact solution is known (`Exact solution/Known`). */
+    const bool exact_solution_known;
+
   private:
     class Expression;
-    class BoundaryValues;
+
+    /** The expressions of the scene, and what compiling them asks for. */
+    using Scene =
+      std::vector<std::pair<Expression *, CompiledFunctions::Request>>;
 
     void
-    compile(
-      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-                                          &scene,
-      const std::map<std::string, double> &constants);
+    compile(const Scene &scene, const std::map<std::string, double> &constants);
 
     void
-    manufacture(
-      const std::vector<std::pair<Expression *, CompiledFunctions::Request>>
-        &scene);
-
-    void
-    check_gradient_entries(const Point<dim> &p) const;
+    manufacture(const Scene &scene);
 
     std::unique_ptr<CompiledFunctions> compiled;
 
@@ -206,7 +192,6 @@ namespace membranes
     std::unique_ptr<Expression>                g2;
     std::unique_ptr<Function<dim>>             g_and_g2;
 
-    const bool                                 known;
     const bool                                 manufactured;
     std::array<std::unique_ptr<Expression>, 2> exact_u;
     std::unique_ptr<Expression>                exact_action;
