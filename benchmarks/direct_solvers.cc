@@ -218,7 +218,7 @@ namespace
         parameters.solver, discretization, data, pcout, timer, MPI_COMM_WORLD);
       solver.setup(problem, dof_handler);
       solution.reinit(std::vector<IndexSet>(2, owned), MPI_COMM_WORLD);
-      solver.solve(problem, dof_handler, action, solution, active_set);
+      solver.solve(problem, action, solution, active_set);
       ghosted_solution.reinit(std::vector<IndexSet>(2, owned),
                               std::vector<IndexSet>(2, relevant),
                               MPI_COMM_WORLD);

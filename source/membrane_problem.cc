@@ -206,12 +206,8 @@ namespace membranes
                0.;
     try
       {
-        statistics = active_set_solver.solve(discrete_problem,
-                                             dof_handler,
-                                             action,
-                                             solution,
-                                             active_set,
-                                             expected_error);
+        statistics = active_set_solver.solve(
+          discrete_problem, action, solution, active_set, expected_error);
       }
     catch (const ActiveSetNotConverged &error)
       {

@@ -267,7 +267,7 @@ namespace
     void
     solve()
     {
-      solver.solve(discrete_problem, dof_handler, action, solution, active_set);
+      solver.solve(discrete_problem, action, solution, active_set);
       ghosted_solution = solution;
       lambda_h         = action.lambda_h(discrete_problem, constraints);
     }

@@ -360,7 +360,6 @@ namespace membranes
   template <int dim>
   typename ActiveSetSolver<dim>::Statistics
   ActiveSetSolver<dim>::solve(const DiscreteProblem<dim> &problem,
-                              const DoFHandler<dim>      &dof_handler,
                               DiscreteAction<dim>        &action,
                               VectorType                 &solution,
                               ActiveSet<dim>             &active_set,

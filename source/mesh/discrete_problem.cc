@@ -102,15 +102,6 @@ namespace membranes
 
 
   template <int dim>
-  const AffineConstraints<double> &
-  DiscreteProblem<dim>::constraints(const unsigned int i) const
-  {
-    return membrane_constraints[i];
-  }
-
-
-
-  template <int dim>
   void
   DiscreteProblem<dim>::assemble(
     const DoFHandler<dim>           &dof_handler,
@@ -231,60 +222,6 @@ namespace membranes
 
 
   template <int dim>
-  MPI_Comm
-  DiscreteProblem<dim>::get_mpi_communicator() const
-  {
-    return mpi_communicator;
-  }
-
-
-
-  template <int dim>
-  const IndexSet &
-  DiscreteProblem<dim>::locally_owned_dofs() const
-  {
-    return owned_dofs;
-  }
-
-
-
-  template <int dim>
-  const IndexSet &
-  DiscreteProblem<dim>::locally_relevant_dofs() const
-  {
-    return relevant_dofs;
-  }
-
-
-
-  template <int dim>
-  const TrilinosWrappers::SparseMatrix &
-  DiscreteProblem<dim>::laplace_matrix() const
-  {
-    return matrix;
-  }
-
-
-
-  template <int dim>
-  const typename DiscreteProblem<dim>::VectorType &
-  DiscreteProblem<dim>::loads(const unsigned int i) const
-  {
-    return load_vectors[i];
-  }
-
-
-
-  template <int dim>
-  const typename DiscreteProblem<dim>::VectorType &
-  DiscreteProblem<dim>::lifted_loads(const unsigned int i) const
-  {
-    return lifted_load_vectors[i];
-  }
-
-
-
-  template <int dim>
   const double *
   DiscreteProblem<dim>::cell_loads(
     const typename DoFHandler<dim>::active_cell_iterator &cell) const
@@ -303,33 +240,6 @@ namespace membranes
     const double *statistics =
       cell_loads(cell) + loads_per_cell - 4; // f̄_1K, f̄_2K, osc_1K, osc_2K
     return {statistics[i], statistics[2 + i]};
-  }
-
-
-
-  template <int dim>
-  const std::vector<typename DiscreteProblem<dim>::Vertex> &
-  DiscreteProblem<dim>::vertices() const
-  {
-    return interior_vertices;
-  }
-
-
-
-  template <int dim>
-  const std::vector<unsigned int> &
-  DiscreteProblem<dim>::local_positions() const
-  {
-    return positions;
-  }
-
-
-
-  template <int dim>
-  const std::vector<types::global_dof_index> &
-  DiscreteProblem<dim>::locally_relevant_vertices() const
-  {
-    return relevant_vertices;
   }
 
 

@@ -184,18 +184,16 @@ namespace membranes
           const DoFHandler<dim>      &dof_handler);
 
     /**
-     * Run the active set method on the mesh of @p problem and
-     * @p dof_handler (those of the last setup()) from the initial guess
-     * @p solution (locally owned entries) and the initial @p active_set. On
-     * return both hold the
-     * converged iterate, and @p action holds λ_a for it; if
-     * ActiveSetNotConverged is thrown, the last iterate. @p expected_error
-     * is the discretization error η̃ expected on this mesh for balanced
-     * stopping, 0 if none is known.
+     * Run the active set method on the mesh of @p problem (that of the last
+     * setup()) from the initial guess @p solution (locally owned entries)
+     * and the initial @p active_set. On return both hold the converged
+     * iterate, and @p action holds λ_a for it; if ActiveSetNotConverged is
+     * thrown, the last iterate. @p expected_error is the discretization
+     * error η̃ expected on this mesh for balanced stopping, 0 if none is
+     * known.
      */
     Statistics
     solve(const DiscreteProblem<dim> &problem,
-          const DoFHandler<dim>      &dof_handler,
           DiscreteAction<dim>        &action,
           VectorType                 &solution,
           ActiveSet<dim>             &active_set,

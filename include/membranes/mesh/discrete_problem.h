@@ -116,31 +116,52 @@ namespace membranes
      * same lines with the same weights; only the inhomogeneities differ.
      */
     const AffineConstraints<double> &
-    constraints(const unsigned int i) const;
+    constraints(const unsigned int i) const
+    {
+      return membrane_constraints[i];
+    }
 
     MPI_Comm
-    get_mpi_communicator() const;
+    get_mpi_communicator() const
+    {
+      return mpi_communicator;
+    }
     /**
      * The index sets of the step-40 layout: the locally owned DoFs of the
      * mesh, and those of the owned and ghost cells. Every block of a vector
      * of the mesh has them.
      */
     const IndexSet &
-    locally_owned_dofs() const;
+    locally_owned_dofs() const
+    {
+      return owned_dofs;
+    }
     const IndexSet &
-    locally_relevant_dofs() const;
+    locally_relevant_dofs() const
+    {
+      return relevant_dofs;
+    }
 
     /** A, condensed with the hanging node constraints and boundary values. */
     const TrilinosWrappers::SparseMatrix &
-    laplace_matrix() const;
+    laplace_matrix() const
+    {
+      return matrix;
+    }
 
     /** F_i, condensed with the hanging node constraints. */
     const VectorType &
-    loads(const unsigned int i) const;
+    loads(const unsigned int i) const
+    {
+      return load_vectors[i];
+    }
 
     /** F_i − μ_i A_{·,∂} g_i, condensed as A (zero in constrained rows). */
     const VectorType &
-    lifted_loads(const unsigned int i) const;
+    lifted_loads(const unsigned int i) const
+    {
+      return lifted_load_vectors[i];
+    }
 
     /** The loads F_1K, F_2K of the locally owned cell @p cell. */
     const double *
@@ -158,7 +179,10 @@ namespace membranes
 
     /** The locally owned vertices of V_h, by increasing DoF. */
     const std::vector<Vertex> &
-    vertices() const;
+    vertices() const
+    {
+      return interior_vertices;
+    }
 
     /**
      * W_a = u1h(a) − u2h(a) at the locally owned vertex k of vertices(),
@@ -186,14 +210,20 @@ namespace membranes
      * none.
      */
     const std::vector<unsigned int> &
-    local_positions() const;
+    local_positions() const
+    {
+      return positions;
+    }
 
     /**
      * The DoFs of the locally relevant vertices of V_h: those of the
      * locally owned and ghost cells.
      */
     const std::vector<types::global_dof_index> &
-    locally_relevant_vertices() const;
+    locally_relevant_vertices() const
+    {
+      return relevant_vertices;
+    }
 
   private:
     /**
