@@ -1,6 +1,5 @@
 #include <Epetra_Import.h>
 #include <Epetra_Vector.h>
-#include <deal.II/lac/trilinos_index_access.h>
 #include <membranes/active_set/active_set_system.h>
 
 namespace membranes
@@ -65,13 +64,8 @@ namespace membranes
     const auto &vertices = problem.vertices();
     auto        vertex   = vertices.begin();
     MatrixRow   row;
-    int        *indices;
-    row.column = [&](const int e) -> types::global_dof_index {
-      return TrilinosWrappers::global_index(columns, indices[e]);
-    };
-    row.active_column = [&](const int e) -> bool {
-      return active_columns[indices[e]];
-    };
+    row.column_map     = &columns;
+    row.active_columns = &active_columns;
     for (int r = 0; r < epetra_matrix.NumMyRows(); ++r)
       {
         row.dof = TrilinosWrappers::global_index(epetra_matrix.RowMap(), r);
@@ -80,7 +74,9 @@ namespace membranes
         row.active             = active_columns[columns.LID(
           static_cast<TrilinosWrappers::types::int_type>(row.dof))];
         row.stiffness_diagonal = row.active ? vertex->stiffness_diagonal : 0;
+        int *indices;
         epetra_matrix.ExtractMyRowView(r, row.n_entries, row.values, indices);
+        row.columns = indices;
         row_function(row);
       }
   }

@@ -4,6 +4,7 @@
 #include <deal.II/base/index_set.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/trilinos_index_access.h>
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
@@ -111,9 +112,25 @@ namespace membranes
       double                  stiffness_diagonal;
       int                     n_entries;
       double                 *values;
-      /** The DoF of entry @p e and whether it is an active vertex. */
-      std::function<types::global_dof_index(int)> column;
-      std::function<bool(int)>                    active_column;
+      /** Epetra's local column indices of the entries. */
+      const int *columns;
+      /** The column map of the matrix, and the status of each column. */
+      const Epetra_BlockMap   *column_map;
+      const std::vector<char> *active_columns;
+
+      /** The DoF of entry @p e. */
+      types::global_dof_index
+      column(const int e) const
+      {
+        return TrilinosWrappers::global_index(*column_map, columns[e]);
+      }
+
+      /** Whether the DoF of entry @p e is an active vertex. */
+      bool
+      active_column(const int e) const
+      {
+        return (*active_columns)[columns[e]];
+      }
     };
 
     /**
