@@ -156,7 +156,8 @@ namespace membranes
   /**
    * What one thread needs on an edge between quadrilaterals: the two traces
    * of the gradient of each membrane on the edge, with matching points,
-   * on the cell (side 0) and on its neighbour (side 1).
+   * from the nodal values of the cell (side 0) and of its neighbour
+   * (side 1).
    */
   template <int dim>
   struct ErrorEstimator<dim>::JumpScratch
@@ -164,6 +165,9 @@ namespace membranes
     JumpScratch(const Discretization<dim> &discretization)
     {
       const FiniteElement<dim> &fe = *discretization.fe;
+      for (auto &membrane_values : local_dofs)
+        for (auto &values : membrane_values)
+          values.resize(fe.n_dofs_per_cell());
       if (!fe.reference_cell().is_simplex())
         interface_values =
           std::make_unique<FEInterfaceValues<dim>>(*discretization.mapping,
@@ -177,6 +181,8 @@ namespace membranes
     std::unique_ptr<FEInterfaceValues<dim>> interface_values;
     /** traces[i][side]: ∇u_ih at the points of the edge. */
     std::array<std::array<std::vector<Tensor<1, dim>>, 2>, 2> traces;
+    /** local_dofs[i][side]: the nodal values of u_ih on that cell. */
+    std::array<std::array<std::vector<double>, 2>, 2> local_dofs;
   };
 
 
@@ -261,14 +267,19 @@ namespace membranes
                             QGaussSimplex<dim>(1),
                             update_gradients);
     std::vector<Tensor<1, dim>> gradient(1);
+    std::vector<double> local_dofs(discretization.fe->n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (!cell->is_artificial())
         {
           fe_values.reinit(cell);
           for (unsigned int i = 0; i < 2; ++i)
             {
-              fe_values.get_function_gradients(ghosted_solution.block(i),
-                                               gradient);
+              cell->get_dof_values(ghosted_solution.block(i),
+                                   local_dofs.begin(),
+                                   local_dofs.end());
+              fe_values[FEValuesExtractors::Scalar(0)]
+                .get_function_gradients_from_local_dof_values(local_dofs,
+                                                              gradient);
               cell_gradients[cell->active_cell_index()][i] = gradient[0];
             }
         }
@@ -333,12 +344,21 @@ namespace membranes
     std::array<double, 2> integrals{};
     for (unsigned int i = 0; i < 2; ++i)
       {
-        auto &traces = scratch.traces[i];
+        auto &traces     = scratch.traces[i];
+        auto &local_dofs = scratch.local_dofs[i];
+        cell->get_dof_values(ghosted_solution.block(i),
+                             local_dofs[0].begin(),
+                             local_dofs[0].end());
+        neighbor->get_dof_values(ghosted_solution.block(i),
+                                 local_dofs[1].begin(),
+                                 local_dofs[1].end());
         for (unsigned int side = 0; side < 2; ++side)
           {
             traces[side].resize(n_q);
-            interface_values.get_fe_face_values(side).get_function_gradients(
-              ghosted_solution.block(i), traces[side]);
+            interface_values
+              .get_fe_face_values(side)[FEValuesExtractors::Scalar(0)]
+              .get_function_gradients_from_local_dof_values(local_dofs[side],
+                                                            traces[side]);
           }
         for (unsigned int q = 0; q < n_q; ++q)
           integrals[i] += std::pow(data.mu[i] * (traces[0][q] - traces[1][q]) *
