@@ -67,26 +67,5 @@ namespace membranes
 
 
 
-  template <int dim>
-  unsigned int
-  CellSystem<dim>::n_load_entries() const
-  {
-    return 2 * laplace_matrix.m() + 4;
-  }
-
-
-
-  template <int dim>
-  void
-  CellSystem<dim>::copy_loads(double *cell_loads) const
-  {
-    for (const auto &load : loads)
-      cell_loads = std::copy(load.begin(), load.end(), cell_loads);
-    cell_loads = std::copy(load_mean.begin(), load_mean.end(), cell_loads);
-    std::copy(load_oscillation.begin(), load_oscillation.end(), cell_loads);
-  }
-
-
-
   template class CellSystem<2>;
 } // namespace membranes

@@ -18,7 +18,6 @@ namespace membranes
     : discretization(discretization)
     , data(data)
     , mpi_communicator(MPI_COMM_SELF)
-    , loads_per_cell(0)
   {}
 
 
@@ -110,7 +109,8 @@ namespace membranes
     VectorType                      &stiffness_diagonal)
   {
     // The cell loop on threads: each works with its own CellSystem, the
-    // loads of every cell go to that cell's own slot of loads_of_cells, and
+    // mean and oscillation of the loads of every cell go to that cell's own
+    // entry of load_statistics, and
     // the copier adds the cell's contributions to the global objects, as
     // step-41 does, by distribute_local_to_global: A_K condensed with the
     // constraints of the mesh, the loads F_iK with the hanging node
@@ -125,10 +125,8 @@ namespace membranes
       std::vector<types::global_dof_index> dof_indices;
     };
     const unsigned int n_vertices = dof_handler.get_fe().n_dofs_per_cell();
-    loads_per_cell = CellSystem<dim>(discretization, data).n_load_entries();
-    loads_of_cells.assign(dof_handler.get_triangulation().n_active_cells() *
-                            loads_per_cell,
-                          0.);
+    load_statistics.assign(dof_handler.get_triangulation().n_active_cells(),
+                           {});
     FullMatrix<double> membrane_matrix(n_vertices);
     run_on_cells<CellContribution>(
       dof_handler,
@@ -140,8 +138,11 @@ namespace membranes
         if (!cell->is_locally_owned())
           return;
         cell_system.reinit(cell);
-        cell_system.copy_loads(
-          &loads_of_cells[cell->active_cell_index() * loads_per_cell]);
+        load_statistics[cell->active_cell_index()] = {
+          {cell_system.load_mean[0],
+           cell_system.load_mean[1],
+           cell_system.load_oscillation[0],
+           cell_system.load_oscillation[1]}};
         contribution.laplace_matrix = cell_system.laplace_matrix;
         contribution.loads          = cell_system.loads;
         contribution.lumped_mass    = cell_system.lumped_mass;
@@ -222,23 +223,12 @@ namespace membranes
 
 
   template <int dim>
-  const double *
-  DiscreteProblem<dim>::cell_loads(
-    const typename DoFHandler<dim>::active_cell_iterator &cell) const
-  {
-    return &loads_of_cells[cell->active_cell_index() * loads_per_cell];
-  }
-
-
-
-  template <int dim>
   std::pair<double, double>
   DiscreteProblem<dim>::load_mean_and_oscillation(
     const typename DoFHandler<dim>::active_cell_iterator &cell,
     const unsigned int                                    i) const
   {
-    const double *statistics =
-      cell_loads(cell) + loads_per_cell - 4; // f̄_1K, f̄_2K, osc_1K, osc_2K
+    const auto &statistics = load_statistics[cell->active_cell_index()];
     return {statistics[i], statistics[2 + i]};
   }
 

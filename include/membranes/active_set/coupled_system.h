@@ -22,15 +22,15 @@ namespace membranes
    * AffineConstraints object in this numbering, merged with the hanging
    * node constraints and the boundary values u1 = g_h, u2 = g2_h of each
    * block (those of DiscreteProblem, built once per mesh). Every iteration
-   * assembles its system anew in a loop over the cells, each cell's matrix
-   * (block diagonal, μ_i A_K on membrane i) and loads F_iK (computed once per
-   * mesh, DiscreteProblem::cell_loads()) condensed by
-   * distribute_local_to_global with these constraints: the equations of u1 and
-   * u2 at an active vertex are added, so the solution of each iteration
-   * satisfies Prop. 12 (λ from either membrane) by construction; on inactive
-   * vertices both equations hold, i.e. λ_a = 0. This is the reference method:
-   * clear, and an assembly of the whole system per iteration (its cost is in
-   * benchmarks/README.md).
+   * assembles its system anew from the rows of A (condensed with the
+   * hanging node and boundary constraints already), block diagonal with
+   * μ_i A on membrane i and the lifted loads, condensed with the contact
+   * lines as distribute_local_to_global would condense them in a cell
+   * loop: the equations of u1 and u2 at an active vertex are added, so the
+   * solution of each iteration satisfies Prop. 12 (λ from either membrane) by
+   * construction; on inactive vertices both equations hold, i.e. λ_a = 0. This
+   * is the reference method: clear, and an assembly of the whole system per
+   * iteration (its cost is in benchmarks/README.md).
    *
    * The rows of the two membranes are forces of tensions μ1 and μ2, and of
    * μ1 + μ2 where the contact constraint adds them: for tension ratios far

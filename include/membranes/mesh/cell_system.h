@@ -25,9 +25,8 @@ namespace membranes
    *
    * The membranes do not couple in (3.4): the cell matrix of membrane i is
    * μ_i A_K. DiscreteProblem assembles the Laplacian and the loads of the
-   * mesh from these, once per mesh, and keeps the loads F_iK of each cell;
-   * CoupledSystem assembles its block system from A_K with those cell
-   * loads, and DecoupledSystem the matrix of w from A_K: all see the same
+   * mesh from these, once per mesh, and every system of the active set
+   * method builds on that Laplacian and those loads: all see the same
    * bilinear form and the same quadrature of the loads.
    */
   template <int dim>
@@ -40,17 +39,6 @@ namespace membranes
     /** Compute every matrix and vector below on @p cell. */
     void
     reinit(const typename DoFHandler<dim>::active_cell_iterator &cell);
-
-    /** The number of entries that copy_loads() writes: 2 n_v + 4. */
-    unsigned int
-    n_load_entries() const;
-
-    /**
-     * Write F_1K, then F_2K into @p cell_loads (2 n_v entries), followed
-     * by load_mean and load_oscillation (2 entries each).
-     */
-    void
-    copy_loads(double *cell_loads) const;
 
     /** A_K. */
     FullMatrix<double> laplace_matrix;

@@ -56,9 +56,9 @@ namespace membranes
    *   sides of membrane i. Their difference is the boundary column part of
    *   μ_i A U_i, so that μ_i (A U_i)_a with the columns of ∂ω is
    *   stiffness_term() without a second matrix;
-   * - the cell loads F_1K, F_2K (and the mean and oscillation of each load
-   *   on K) in the layout of CellSystem::copy_loads(), so that no system
-   *   evaluates the data again on this mesh;
+   * - the mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of each load on
+   *   each locally owned cell K, the data terms of the residual estimator,
+   *   from the evaluations of the loads of this assembly;
    * - the set V_h of the unconstrained interior vertices with, for each
    *   locally owned one, d_a = ∫ φ_a (the lumped mass of (4.17); with
    *   hanging nodes the row sum of the constrained mass matrix), ∫|∇φ_a|²
@@ -163,11 +163,6 @@ namespace membranes
       return lifted_load_vectors[i];
     }
 
-    /** The loads F_1K, F_2K of the locally owned cell @p cell. */
-    const double *
-    cell_loads(
-      const typename DoFHandler<dim>::active_cell_iterator &cell) const;
-
     /**
      * The mean f̄_iK and the oscillation ∫_K (f_i − f̄_iK)² of load @p i on
      * the locally owned cell @p cell.
@@ -235,8 +230,9 @@ namespace membranes
                      const AffineConstraints<double> &hanging_node_constraints);
 
     /**
-     * The cell loop: A, the loads, d_a, ∫|∇φ_a|² and the cell loads, each
-     * condensed by distribute_local_to_global with its constraints.
+     * The cell loop: A, the loads, d_a and ∫|∇φ_a|², each condensed by
+     * distribute_local_to_global with its constraints, and the
+     * load_statistics of each cell.
      */
     void
     assemble(const DoFHandler<dim>           &dof_handler,
@@ -262,12 +258,10 @@ namespace membranes
     std::array<VectorType, 2>                load_vectors;
     std::array<VectorType, 2>                lifted_load_vectors;
     /**
-     * The cell loads as CellSystem::copy_loads() writes them, loads_per_cell
-     * = 2 n_v + 4 numbers per cell from active_cell_index() · loads_per_cell
-     * on (n_v hat functions per cell).
+     * f̄_1K, f̄_2K, then ∫_K (f_1 − f̄_1K)², ∫_K (f_2 − f̄_2K)² of each
+     * cell, by active_cell_index().
      */
-    std::vector<double> loads_of_cells;
-    unsigned int        loads_per_cell;
+    std::vector<std::array<double, 4>> load_statistics;
 
     std::vector<Vertex>                  interior_vertices;
     std::vector<unsigned int>            positions;
