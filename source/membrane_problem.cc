@@ -43,7 +43,7 @@ namespace membranes
         computes_fluxes() ?
           std::make_unique<FluxEquilibration<dim>>(*flux_reconstruction) :
           nullptr)
-    , report(parameters.output, pcout)
+    , report(parameters.output, parameters.exact_solution, pcout)
     , field_output(parameters.output, discretization, mpi_communicator)
     , output_directory(parameters.output.directory,
                        provenance,
@@ -253,29 +253,37 @@ namespace membranes
 
 
   /**
-   * The errors against the exact solution, when it is known (after
-   * postprocess(), which gives λ_h). Timed on their own, as `errors`: a
-   * run without an exact solution never pays for them, so they are not
-   * part of the wall time of the method.
+   * The errors against the exact solution, when it is known, in the norms
+   * that `Exact solution/Norms` names (after postprocess(), which gives
+   * λ_h). Timed on their own, as `errors`: a run without an exact solution
+   * never pays for them, so they are not part of the wall time of the
+   * method.
    */
   template <int dim>
-  std::optional<ErrorRecord>
+  ErrorRecord
   MembraneProblem<dim>::compute_errors()
   {
-    if (!data.exact_solution_known)
+    const Parameters::ExactSolution &exact = parameters.exact_solution;
+    if (!exact.computes_any())
       return {};
     TimerOutput::Scope scope(computing_timer, "errors");
     ErrorRecord        errors =
-      ErrorNorms<dim>(discretization,
-                      data,
-                      parameters.exact_solution.reference_quadrature)
-        .compute(
-          dof_handler, ghosted_solution, dual_mesh, lambda_h, mpi_communicator);
+      ErrorNorms<dim>(discretization, data, exact.reference_quadrature)
+        .compute(dof_handler,
+                 ghosted_solution,
+                 dual_mesh,
+                 lambda_h,
+                 exact,
+                 mpi_communicator);
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
     // (benchmarks/README.md, "The H^-1 norm of the action").
-    errors.lambda_Hm1 =
-      NegativeNorm<dim>(discretization)
-        .lambda_error(dof_handler, dual_mesh, lambda_h, data, mpi_communicator);
+    if (exact.computes("err_lambda_Hm1"))
+      errors.lambda_Hm1 = NegativeNorm<dim>(discretization)
+                            .lambda_error(dof_handler,
+                                          dual_mesh,
+                                          lambda_h,
+                                          data,
+                                          mpi_communicator);
     return errors;
   }
 
@@ -297,8 +305,8 @@ namespace membranes
 
   /**
    * The residual estimator η and its indicators η_K², when it drives
-   * adaptive refinement or a target estimator, or the exact solution is
-   * known (with its effectivity index η / |||e|||), or balanced stopping
+   * adaptive refinement or a target estimator, or the run computes the
+   * energy error (with its effectivity index η / |||e|||), or balanced stopping
    * needs it on every mesh. Its indicators are kept for marking unless the
    * flux estimator drives refinement (reconstruct_fluxes()).
    */
@@ -314,7 +322,8 @@ namespace membranes
       parameters.refinement.estimator == Parameters::Estimator::flux;
     const bool drives = adaptive || parameters.refinement.target_estimator > 0;
     indicators.reinit(0);
-    if (!(drives && !flux_drives) && !data.exact_solution_known && !balanced)
+    if (!(drives && !flux_drives) &&
+        !parameters.exact_solution.computes("err_energy") && !balanced)
       return {};
     TimerOutput::Scope scope(computing_timer, "estimate");
     Vector<double>     residual_indicators;
@@ -642,7 +651,7 @@ namespace membranes
     record.times.estimate    = time_of("estimate");
     if (computes_fluxes())
       record.times.flux = time_of("flux");
-    if (data.exact_solution_known)
+    if (parameters.exact_solution.computes_any())
       record.times.errors = time_of("errors");
     record.cumulative_wall_time =
       previous_record.cumulative_wall_time + record.times.method();
@@ -662,6 +671,11 @@ namespace membranes
   MembraneProblem<dim>::run()
   {
     make_grid();
+    if (parameters.exact_solution.known &&
+        !parameters.exact_solution.computes("err_energy"))
+      pcout << "No effectivity index: it needs err_energy in Exact "
+               "solution/Norms"
+            << std::endl;
     output_directory.claim();
     for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
       {

@@ -44,6 +44,11 @@ CASES = [
     ("exact gradient with one expression",
      "subsection Exact solution\n  set Known = true\n"
      "  set u1 gradient = 2*x\nend\n", [], ["Exact solution/u1 gradient"]),
+    ("misspelled error norm",
+     "subsection Exact solution\n  set Known = true\n"
+     "  set Norms = err_u1_H1, err_lambda_H-1\nend\n", [],
+     ["Exact solution/Norms", "err_lambda_H-1", "err_lambda_Hm1",
+      "err_lambda_L2_omega_h"]),
     ("manufactured data with f1 set",
      "subsection Problem\n  set f1 = 1\nend\n"
      "subsection Exact solution\n  set Manufactured data = true\nend\n", [],

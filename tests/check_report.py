@@ -337,6 +337,13 @@ def check_empty(report, column):
     return True, f"all {len(report.rows)} values empty"
 
 
+def check_absent(report, column):
+    """The column is not in the report (not computed by the run)."""
+    if report.has(column):
+        return False, "in the report, expected absent"
+    return True, "absent"
+
+
 def check_filled(report, column):
     """Every value non-empty."""
     if not report.rows:
@@ -401,6 +408,7 @@ CHECKS = {
     "--min-last": (check_min_last, lambda s: split_bound(s, ">="),
                    lambda a: f"{a[0]}>={fmt(a[1])}"),
     "--empty": (check_empty, str, str),
+    "--absent": (check_absent, str, str),
     "--filled": (check_filled, str, str),
     "--rows": (check_rows, non_negative_int, str),
     "--decreasing": (check_decreasing, str, str),
@@ -412,7 +420,7 @@ METAVARS = {"--rate": "COL>=VALUE", "--max-rate": "COL<=VALUE",
             "--band": "COL<=VALUE", "--max": "COL<=VALUE",
             "--min": "COL>=VALUE", "--max-after-first": "COL<=VALUE",
             "--max-last": "COL<=VALUE", "--min-last": "COL>=VALUE",
-            "--empty": "COL", "--filled": "COL", "--rows": "N",
+            "--empty": "COL", "--absent": "COL", "--filled": "COL", "--rows": "N",
             "--decreasing": "COL", "--hanging-nodes": "N"}
 
 
@@ -445,7 +453,7 @@ def columns_of(option, argument):
     if option in ("--max", "--min", "--max-after-first", "--max-last",
                   "--min-last", "--band", "--growth"):
         return [argument[0]]
-    if option == "--rows":
+    if option in ("--rows", "--absent"):
         return []
     if option == "--hanging-nodes":
         return ["cells", "levels"]

@@ -26,7 +26,9 @@ Two empty fields agree (a column such as ``eta_linearization`` is empty on
 the first mesh); an empty field never agrees with a number; NaN never agrees
 with anything.  A column empty in every row of both files compares nothing,
 and fails, unless ``--empty`` names it: the columns ``--empty`` names are
-expected to be empty in every row of both files, and fail otherwise.
+expected to be empty in every row of both files, and fail otherwise; an
+error or effectivity column that ``--empty`` names may also be absent from
+both (a run leaves out what it does not compute).
 With ``--one-sided`` only b - a is bounded so (b <= a always agrees): b
 costs or errs at most that much more than a, e.g. ``--rtol 0 --one-sided``
 on an iteration count says b <= a.  Columns are looked up by name in each
@@ -74,7 +76,9 @@ Two empty fields agree, and so does a column empty in every row of both
 files (a quantity the run does not compute); an empty field never agrees
 with a number. A column of either report that REPORT_COLUMNS does not
 classify fails, and so does one that it classifies and a report lacks: a
-new column of the report must be given a kind before it passes.
+new column of the report must be given a kind before it passes. Only the
+errors and effectivities, which a run leaves out when it does not compute
+them (``Exact solution/Norms``), may be absent, and then from both.
 
 One line ``PASS ...`` or ``FAIL ...`` is printed for the row count and for
 each column (``SKIP ...`` and why for a column not compared), giving the
@@ -119,6 +123,11 @@ REPORT_COLUMNS = {
                      "time_estimate_s", "time_flux_s", "time_errors_s",
                      "memory_mb"), COST),
 }
+
+# The columns against the exact solution, which a run that does not compute
+# them leaves out of report.csv: absent from both reports, they are skipped.
+VERIFICATION = {column for column in REPORT_COLUMNS
+                if column.startswith("err_") or column.endswith("effectivity")}
 
 # Why a column of the kind varies or cost is not compared (COST: the
 # times).
@@ -274,6 +283,8 @@ def compare_whole_reports(arguments):
         if column not in REPORT_COLUMNS:
             passed, message = False, ("not classified: give it a kind in "
                                       f"REPORT_COLUMNS of {PROG}")
+        elif len(missing) == 2 and column in VERIFICATION:
+            passed, message = None, "in neither report (not computed)"
         elif missing:
             passed, message = False, ("classified, but not in "
                                       + " and ".join(missing))
@@ -369,6 +380,11 @@ def compare(arguments):
         missing = [path for path, header in ((arguments.first, header_a),
                                              (arguments.second, header_b))
                    if column not in header]
+        if (len(missing) == 2 and column in arguments.empty
+                and column in VERIFICATION):
+            verdicts.append(report_line(True, column, "in neither file "
+                                        "(not computed), as expected"))
+            continue
         if missing:
             verdicts.append(report_line(False, column, "unknown column in "
                                         + " and ".join(missing)))

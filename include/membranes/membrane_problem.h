@@ -88,7 +88,7 @@ namespace membranes
     solve(KKTDefects &defects);
     IdentityRecord
     postprocess(const KKTDefects &defects);
-    std::optional<ErrorRecord>
+    ErrorRecord
     compute_errors();
     bool
     computes_fluxes() const;

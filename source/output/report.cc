@@ -10,14 +10,16 @@ namespace membranes
   {
     /**
      * One field of a row of report.csv: the column name, the value (empty
-     * when the run does not compute it), and whether it counts something
-     * (a whole number).
+     * when the run does not compute it), whether it counts something (a
+     * whole number), and for a column against the exact solution the error
+     * column of `Exact solution/Norms` without which the run leaves it out.
      */
     struct Field
     {
       std::string           name;
       std::optional<double> value;
       bool                  count = false;
+      std::string           norm  = "";
     };
 
     /** The row of one cycle, its fields in the order of the columns. */
@@ -25,10 +27,10 @@ namespace membranes
     row(const CycleRecord &r)
     {
       const bool count = true;
-      // A member of an optional record: empty where the record is.
-      const auto error = [&r](const double ErrorRecord::*norm) {
-        return r.errors ? std::optional<double>((*r.errors).*norm) :
-                          std::nullopt;
+      // The columns against the exact solution.
+      const auto error = [&r](const std::string          &name,
+                              const std::optional<double> ErrorRecord::*norm) {
+        return Field{name, r.errors.*norm, false, name};
       };
       const auto flux = [&r](const double FluxRecord::*part) {
         return r.flux ? std::optional<double>((*r.flux).*part) : std::nullopt;
@@ -37,10 +39,14 @@ namespace membranes
         [&r](const std::optional<double> FluxRecord::*defect) {
           return r.flux ? (*r.flux).*defect : std::nullopt;
         };
-      const auto effectivity = [&r](const std::optional<double> &estimator) {
-        return estimator && r.errors ?
-                 std::optional<double>(*estimator / r.errors->energy) :
-                 std::nullopt;
+      const auto effectivity = [&r](const std::string           &name,
+                                    const std::optional<double> &estimator) {
+        return Field{name,
+                     estimator && r.errors.energy ?
+                       std::optional<double>(*estimator / *r.errors.energy) :
+                       std::nullopt,
+                     false,
+                     "err_energy"};
       };
       const std::optional<double> flux_estimator = flux(&FluxRecord::estimator);
       const SolveRecord          &solve          = r.solve;
@@ -53,13 +59,13 @@ namespace membranes
               {"active_vertices", solve.active_vertices, count},
               {"wall_time_s", times.method()},
               {"cumulative_wall_time_s", r.cumulative_wall_time},
-              {"err_u1_H1", error(&ErrorRecord::u1_H1)},
-              {"err_u2_H1", error(&ErrorRecord::u2_H1)},
-              {"err_u1_L2", error(&ErrorRecord::u1_L2)},
-              {"err_u2_L2", error(&ErrorRecord::u2_L2)},
-              {"err_lambda_L2", error(&ErrorRecord::lambda_L2)},
+              error("err_u1_H1", &ErrorRecord::u1_H1),
+              error("err_u2_H1", &ErrorRecord::u2_H1),
+              error("err_u1_L2", &ErrorRecord::u1_L2),
+              error("err_u2_L2", &ErrorRecord::u2_L2),
+              error("err_lambda_L2", &ErrorRecord::lambda_L2),
               {"estimator", r.estimator},
-              {"effectivity", effectivity(r.estimator)},
+              effectivity("effectivity", r.estimator),
               {"kkt_residual", solve.kkt_residual},
               {"min_w", identities.min_w},
               {"min_lambda", identities.min_lambda},
@@ -70,10 +76,10 @@ namespace membranes
               {"time_assembly_s", times.assembly},
               {"time_solve_s", times.solve},
               {"time_postprocess_s", times.postprocess},
-              {"err_energy", error(&ErrorRecord::energy)},
+              error("err_energy", &ErrorRecord::energy),
               {"time_estimate_s", times.estimate},
               {"flux_estimator", flux_estimator},
-              {"flux_effectivity", effectivity(flux_estimator)},
+              effectivity("flux_effectivity", flux_estimator),
               {"measure_defect", flux_defect(&FluxRecord::measure_defect)},
               {"conservation_defect",
                flux_defect(&FluxRecord::conservation_defect)},
@@ -89,16 +95,18 @@ namespace membranes
               {"flux_estimator_contact", flux(&FluxRecord::contact)},
               {"flux_estimator_boundary", flux(&FluxRecord::boundary)},
               {"time_errors_s", times.errors},
-              {"err_lambda_L2_omega_h", error(&ErrorRecord::lambda_L2_omega_h)},
-              {"err_lambda_Hm1", error(&ErrorRecord::lambda_Hm1)}};
+              error("err_lambda_L2_omega_h", &ErrorRecord::lambda_L2_omega_h),
+              error("err_lambda_Hm1", &ErrorRecord::lambda_Hm1)};
     }
   } // namespace
 
 
 
-  Report::Report(const Parameters::Output &parameters,
-                 const ConditionalOStream &pcout)
+  Report::Report(const Parameters::Output        &parameters,
+                 const Parameters::ExactSolution &exact,
+                 const ConditionalOStream        &pcout)
     : parameters(parameters)
+    , exact(exact)
     , pcout(pcout)
   {}
 
@@ -110,22 +118,34 @@ namespace membranes
     records.push_back(record);
     if (!parameters.report || !pcout.is_active())
       return;
+    // The columns of the file: every one but those against the exact
+    // solution that this run does not compute.
+    const std::vector<Field> names = row(CycleRecord());
+    std::vector<bool>        written(names.size());
+    for (unsigned int c = 0; c < names.size(); ++c)
+      written[c] = names[c].norm.empty() || exact.computes(names[c].norm);
     write_atomically(parameters.directory + "/report.csv",
-                     [this](std::ostream &out) {
-                       const auto names = row(CycleRecord());
+                     [&](std::ostream &out) {
+                       const char *separator = "";
                        for (unsigned int c = 0; c < names.size(); ++c)
-                         out << (c == 0 ? "" : ",") << names[c].name;
+                         if (written[c])
+                           {
+                             out << separator << names[c].name;
+                             separator = ",";
+                           }
                        out << '\n' << std::setprecision(12);
-                       for (const CycleRecord &record : records)
+                       for (const CycleRecord &r : records)
                          {
-                           const auto fields = row(record);
+                           const auto fields = row(r);
+                           separator         = "";
                            for (unsigned int c = 0; c < fields.size(); ++c)
-                             {
-                               if (c > 0)
-                                 out << ',';
-                               if (fields[c].value)
-                                 out << *fields[c].value;
-                             }
+                             if (written[c])
+                               {
+                                 out << separator;
+                                 separator = ",";
+                                 if (fields[c].value)
+                                   out << *fields[c].value;
+                               }
                            out << '\n';
                          }
                      });

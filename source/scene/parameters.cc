@@ -99,6 +99,15 @@ namespace membranes::Parameters
      */
     const std::string former_fixed_number = "fixed fraction";
 
+    /**
+     * The default of `Exact solution/Norms`: every error column that
+     * ErrorNorms computes in its one pass over the cells, not the H^{-1}
+     * norm of the action (NegativeNorm), which solves a problem of its own.
+     */
+    const std::string default_norms =
+      "err_u1_H1, err_u2_H1, err_u1_L2, err_u2_L2, err_energy, "
+      "err_lambda_L2, err_lambda_L2_omega_h";
+
     /** The defaults of `Bulk parameter` and `Refinement fraction`. */
     const std::string default_bulk_parameter      = "0.5";
     const std::string default_refinement_fraction = "0.5";
@@ -306,6 +315,21 @@ namespace membranes::Parameters
                       "sub-triangle of the dual mesh cut into 4^N triangles "
                       "with 4 points on each, the reference of "
                       "benchmarks/error_quadrature.sh (slow).");
+    std::string names;
+    for (const std::string &name : error_norm_names())
+      names += (names.empty() ? "" : "|") + name;
+    prm.declare_entry(
+      "Norms",
+      default_norms,
+      dealii::Patterns::MultipleSelection(names),
+      "The error columns of the report, a comma-separated list of "
+      "err_u1_H1, err_u2_H1 (full H1 norms), err_u1_L2, err_u2_L2, "
+      "err_energy (the energy norm; the effectivity indices need it), "
+      "err_lambda_L2 (on omega), err_lambda_L2_omega_h (on omega_h), "
+      "err_lambda_Hm1 (the H^-1 norm of (4.20), by a Riesz problem of "
+      "degree 2 on the mesh: it costs more than all others together). "
+      "The default computes all but err_lambda_Hm1, in one pass over the "
+      "cells.");
     prm.leave_subsection();
   }
 
@@ -322,7 +346,27 @@ namespace membranes::Parameters
     manufactured = prm.get_bool("Manufactured data");
 
     reference_quadrature = prm.get_integer("Reference quadrature");
+    norms.clear();
+    for (const std::string &name :
+         dealii::Utilities::split_string_list(prm.get("Norms")))
+      norms.insert(name);
     prm.leave_subsection();
+  }
+
+
+
+  const std::vector<std::string> &
+  ExactSolution::error_norm_names()
+  {
+    static const std::vector<std::string> names{"err_u1_H1",
+                                                "err_u2_H1",
+                                                "err_u1_L2",
+                                                "err_u2_L2",
+                                                "err_energy",
+                                                "err_lambda_L2",
+                                                "err_lambda_L2_omega_h",
+                                                "err_lambda_Hm1"};
+    return names;
   }
 
 

@@ -3,17 +3,48 @@
 # writing it.
 
 # A scene computes and writes only what it asks for: no exact solution, no
-# error columns; no VTU when Write vtu = false; no nodal values by default.
+# error columns (absent from report.csv) and no time for them; no VTU when
+# Write vtu = false; no nodal values by default.
 # Catches: work a scene did not ask for.
 membranes_scene_test(leaves_out case-m-quadrilateral.prm QUICK
   SETTINGS Refinement/Cycles=2 Exact\ solution/Known=false
            Output/Write\ vtu=false
-  CHECKS --empty err_u1_H1 --empty err_u2_H1 --empty err_u1_L2
-         --empty err_u2_L2 --empty err_lambda_L2
-         --empty err_lambda_L2_omega_h --empty estimator --empty effectivity --empty flux_estimator --empty time_flux_s
-         --empty conservation_defect
+  CHECKS --absent err_u1_H1 --absent err_u2_H1 --absent err_u1_L2
+         --absent err_u2_L2 --absent err_lambda_L2
+         --absent err_lambda_L2_omega_h --absent err_lambda_Hm1
+         --absent err_energy --absent effectivity --absent flux_effectivity
+         --empty estimator --empty flux_estimator --empty time_flux_s
+         --empty time_errors_s --empty conservation_defect
   FILES --present report.csv --absent *.vtu --absent *.pvd --absent *.tmp
         --absent nodal-values-*.csv)
+
+# Exact solution/Norms: a run computes the error columns its scene names and
+# leaves the others out of report.csv; each computed column equals that of
+# the run with every column (case_m_quadrilateral, which names all eight).
+# Two subsets: one of each pass of ErrorNorms (a displacement norm and an
+# L2 norm of the action) with the H^-1 norm, and the H^-1 norm alone: no
+# pass of ErrorNorms, no err_energy, so no effectivity and, on a uniform
+# run, no residual estimator either. Catches: a column written that was not
+# asked for, a norm that changes when computed without the others (a wrong
+# slot of the squares), an estimator computed for an effectivity that is
+# not reported.
+membranes_scene_test(norms_subset case-m-quadrilateral.prm QUICK
+  SETTINGS Refinement/Cycles=6 Output/Write\ vtu=false
+           "Exact solution/Norms=err_u2_L2, err_lambda_L2_omega_h, err_lambda_Hm1"
+  CHECKS --absent err_u1_H1 --absent err_u2_H1 --absent err_u1_L2
+         --absent err_lambda_L2 --absent err_energy --absent effectivity
+         --absent flux_effectivity --filled err_u2_L2
+         --filled err_lambda_L2_omega_h --filled err_lambda_Hm1
+         --filled time_errors_s --empty estimator)
+membranes_compare(norms_subset_same_values case_m_quadrilateral norms_subset
+  COLUMNS dofs,active_vertices,err_u2_L2,err_lambda_L2_omega_h,err_lambda_Hm1
+  RTOL 1e-12)
+membranes_scene_test(norms_hm1_alone case-m-triangle.prm QUICK
+  SETTINGS Refinement/Cycles=4 Output/Write\ vtu=false
+           Exact\ solution/Norms=err_lambda_Hm1
+  CHECKS --absent err_u1_H1 --absent err_u2_L2 --absent err_lambda_L2
+         --absent err_lambda_L2_omega_h --absent err_energy
+         --absent effectivity --filled err_lambda_Hm1 --empty estimator)
 
 # Bad scenes: one-line error naming the parameter, non-zero exit, no output.
 add_test(NAME bad_scenes

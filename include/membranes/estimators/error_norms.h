@@ -89,14 +89,18 @@ namespace membranes
     /**
      * The errors of @p ghosted_solution (the blocks u1h, u2h, ghosted), with
      * @p lambda_h (DiscreteAction::lambda_h()) read on the dual cells of
-     * @p dual_mesh; all of ErrorRecord but lambda_Hm1 (NegativeNorm's).
+     * @p dual_mesh, that @p exact names in `Norms`: of ErrorRecord all but
+     * lambda_Hm1 (NegativeNorm's). The pass integrates the displacement
+     * errors only if one of them is asked for, and the L² errors of the
+     * action likewise; none asked for, it makes no pass.
      */
     ErrorRecord
-    compute(const DoFHandler<dim> &dof_handler,
-            const BlockVectorType &ghosted_solution,
-            const DualMesh<dim>   &dual_mesh,
-            const VectorType      &lambda_h,
-            const MPI_Comm         mpi_communicator) const;
+    compute(const DoFHandler<dim>           &dof_handler,
+            const BlockVectorType           &ghosted_solution,
+            const DualMesh<dim>             &dual_mesh,
+            const VectorType                &lambda_h,
+            const Parameters::ExactSolution &exact,
+            const MPI_Comm                   mpi_communicator) const;
 
   private:
     const Discretization<dim>    &discretization;

@@ -52,25 +52,27 @@ namespace membranes
 
   /**
    * The errors against a known exact solution, in the norms of the paper,
-   * as ErrorNorms integrates them (its rules and their accuracy there).
+   * as ErrorNorms integrates them (its rules and their accuracy there):
+   * each one where `Exact solution/Norms` names its column, empty
+   * otherwise.
    */
   struct ErrorRecord
   {
     /** The full H1(ω) norms ‖u_i − u_ih‖_{H1(ω)} of (3.5). */
-    double u1_H1 = 0, u2_H1 = 0;
-    double u1_L2 = 0, u2_L2 = 0;
+    std::optional<double> u1_H1, u2_H1;
+    std::optional<double> u1_L2, u2_L2;
     /** ‖λ − λ_h‖_{L2(ω)} with λ_h = 0 on the strip ω ∖ ω_h, as in (4.36). */
-    double lambda_L2 = 0;
+    std::optional<double> lambda_L2;
     /** ‖λ − λ_h‖_{L2(ω_h)}: the same without the strip. */
-    double lambda_L2_omega_h = 0;
+    std::optional<double> lambda_L2_omega_h;
     /** Energy error (Σ_i μ_i |u_i − u_ih|²_{H1})^{1/2} (seminorms). */
-    double energy = 0;
+    std::optional<double> energy;
     /**
      * ‖λ − λ_h‖_{H^{-1}(ω)}, the dual norm (4.20) of H¹₀(ω) with the full
      * H¹ norm, in which Theorem 21 bounds the error (4.34); λ_h = 0 on the
      * strip ω ∖ ω_h (NegativeNorm).
      */
-    double lambda_Hm1 = 0;
+    std::optional<double> lambda_Hm1;
   };
 
   /** The flux estimator and the identities of the flux reconstruction. */
@@ -99,7 +101,10 @@ namespace membranes
     double setup = 0, assembly = 0, solve = 0, postprocess = 0, estimate = 0;
     /** The flux reconstruction and its estimator; where computed. */
     std::optional<double> flux;
-    /** The error norms, a cost that a run without exact solution never pays. */
+    /**
+     * The error norms, a cost that a run without exact solution (or
+     * without `Exact solution/Norms`) never pays.
+     */
     std::optional<double> errors;
 
     /** The phases of the method: all but the error norms. */
@@ -120,8 +125,8 @@ namespace membranes
     MeshRecord     mesh;
     SolveRecord    solve;
     IdentityRecord identities;
-    /** Empty when the exact solution is not known. */
-    std::optional<ErrorRecord> errors;
+    /** The errors the scene asks for (all empty without exact solution). */
+    ErrorRecord errors;
     /** The residual estimator η; empty when not computed. */
     std::optional<double> estimator;
     /** Empty when the fluxes are not reconstructed. */
@@ -152,13 +157,18 @@ namespace membranes
    * A row is one list of (column name, value) pairs, made from a
    * CycleRecord in report.cc: adding a column is one line there (and the
    * member of the record it reports). The effectivity indices are made
-   * there too: an estimator divided by the energy error.
+   * there too: an estimator divided by the energy error. The columns that
+   * compare with the exact solution are in report.csv only where the run
+   * computes them: the errors that `Exact solution/Norms` names, and the
+   * effectivity indices with err_energy; a run without exact solution has
+   * none of them.
    */
   class Report
   {
   public:
-    Report(const Parameters::Output &parameters,
-           const ConditionalOStream &pcout);
+    Report(const Parameters::Output        &parameters,
+           const Parameters::ExactSolution &exact,
+           const ConditionalOStream        &pcout);
 
     /** Add the row of one cycle; write report.csv if asked for. */
     void
@@ -176,9 +186,10 @@ namespace membranes
     print_convergence_table(const bool rates_in_dofs);
 
   private:
-    const Parameters::Output &parameters;
-    const ConditionalOStream &pcout;
-    std::vector<CycleRecord>  records;
+    const Parameters::Output        &parameters;
+    const Parameters::ExactSolution &exact;
+    const ConditionalOStream        &pcout;
+    std::vector<CycleRecord>         records;
   };
 } // namespace membranes
 

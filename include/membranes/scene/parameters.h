@@ -2,8 +2,10 @@
 #define membranes_parameters_h
 
 #include <deal.II/base/parameter_handler.h>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 /**
  * The run-time parameters of a scene. Each struct mirrors one subsection of
@@ -194,6 +196,29 @@ namespace membranes::Parameters
      * with 4^N triangles per sub-triangle.
      */
     unsigned int reference_quadrature;
+    /**
+     * The error columns of report.csv that the run computes (`Norms`), by
+     * their names there; a subset of error_norm_names().
+     */
+    std::set<std::string> norms;
+
+    /** The names of all error columns, the words of `Norms`. */
+    static const std::vector<std::string> &
+    error_norm_names();
+
+    /** Whether the run computes the error column @p name. */
+    bool
+    computes(const std::string &name) const
+    {
+      return known && norms.count(name) != 0;
+    }
+
+    /** Whether the run computes any error column. */
+    bool
+    computes_any() const
+    {
+      return known && !norms.empty();
+    }
 
     static void
     declare_parameters(ParameterHandler &prm);
