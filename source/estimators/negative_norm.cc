@@ -47,6 +47,20 @@ namespace membranes
       {}
       FEValues<dim>       fe_values, density_values, jump_values;
       std::vector<double> rho;
+
+      /**
+       * The last two cells of this thread whose matrix was computed, and
+       * their matrices. The mappings of Discretization are determined by
+       * the vertices of a cell, so a cell that is a translation of one of
+       * them has the same Jacobians at the same quadrature points, the same
+       * shape gradients and JxW, hence the same cell matrix: on a uniform
+       * mesh of quadrilaterals every cell is a translation of the previous
+       * one, on one of triangles every other cell (the two orientations of
+       * the triangles of a square alternate).
+       */
+      std::array<typename Triangulation<dim>::cell_iterator, 2> matrix_cells;
+      std::array<FullMatrix<double>, 2>                         matrices;
+      unsigned int                                              next_matrix = 0;
     };
   } // namespace
 
@@ -109,15 +123,35 @@ namespace membranes
         copy.dof_indices.resize(n_dofs);
         cell->get_dof_indices(copy.dof_indices);
 
-        const FEValues<dim> &fe_values = scratch.fe_values;
-        scratch.fe_values.reinit(cell);
-        for (const unsigned int q : fe_values.quadrature_point_indices())
-          for (unsigned int i = 0; i < n_dofs; ++i)
-            for (unsigned int j = 0; j < n_dofs; ++j)
-              copy.cell_matrix(i, j) +=
-                (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) +
-                 fe_values.shape_value(i, q) * fe_values.shape_value(j, q)) *
-                fe_values.JxW(q);
+        // The cell matrix of a translate of one of the last two cells is
+        // theirs (RieszScratch::matrices).
+        const typename Triangulation<dim>::cell_iterator tria_cell(cell);
+        const auto                                       same =
+          std::find_if(scratch.matrix_cells.begin(),
+                       scratch.matrix_cells.end(),
+                       [&](const auto &other) {
+                         return other.state() == IteratorState::valid &&
+                                tria_cell->is_translation_of(other);
+                       });
+        if (same != scratch.matrix_cells.end())
+          copy.cell_matrix =
+            scratch.matrices[same - scratch.matrix_cells.begin()];
+        else
+          {
+            const FEValues<dim> &fe_values = scratch.fe_values;
+            scratch.fe_values.reinit(cell);
+            for (const unsigned int q : fe_values.quadrature_point_indices())
+              for (unsigned int i = 0; i < n_dofs; ++i)
+                for (unsigned int j = 0; j < n_dofs; ++j)
+                  copy.cell_matrix(i, j) +=
+                    (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) +
+                     fe_values.shape_value(i, q) *
+                       fe_values.shape_value(j, q)) *
+                    fe_values.JxW(q);
+            scratch.matrix_cells[scratch.next_matrix] = tria_cell;
+            scratch.matrices[scratch.next_matrix]     = copy.cell_matrix;
+            scratch.next_matrix ^= 1;
+          }
 
         scratch.density_values.reinit(cell);
         rho(cell,
@@ -201,14 +235,18 @@ namespace membranes
     // (A + M) Z = F by CG with an AMG hierarchy for elements of higher
     // degree. ‖z_h‖²_{H¹} = max_Y 2 F·Y − Y·(A + M)Y, attained at Y = Z: the
     // value at the CG iterate Y errs by ‖Z − Y‖²_{A+M}, the square of the
-    // error of the iterate (F·Y would err by its first power).
+    // error of the iterate (F·Y would err by its first power). Relative to
+    // ‖z_h‖²_{H¹} = ‖Z‖²_{A+M} it is the square of the relative energy
+    // error ‖Z − Y‖_{A+M} / ‖Z‖_{A+M}: a residual reduced by 10⁻⁴ leaves
+    // the value correct to more digits than the report's reference values
+    // keep (benchmarks/README.md, "The H^-1 norm of the action").
     TrilinosWrappers::PreconditionAMG                 amg;
     TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
     amg_data.elliptic              = true;
     amg_data.higher_order_elements = fe->degree > 1;
     amg.initialize(matrix, amg_data);
     TrilinosWrappers::MPI::Vector           z(owned, mpi_communicator);
-    ReductionControl                        control(1000, 1e-300, 1e-6);
+    ReductionControl                        control(1000, 1e-300, 1e-4);
     SolverCG<TrilinosWrappers::MPI::Vector> cg(control);
     cg.solve(matrix, z, rhs, amg);
     TrilinosWrappers::MPI::Vector product(owned, mpi_communicator);
@@ -227,13 +265,13 @@ namespace membranes
                                   const MPI_Comm mpi_communicator) const
   {
     // λ_h on the piece K ∩ D_a of each point, read on the cell of the mesh
-    // of the solution that is the same cell of the triangulation. The
-    // threads of the cell loop call it at once: it keeps no state.
+    // of the solution that is the same cell of the triangulation, and the
+    // exact λ alone (ProblemData::exact_action_list(), not u and ∇u too).
+    // The threads of the cell loop call it at once: it keeps no state.
     const auto rho = [&](const CellIterator            &cell,
                          const DualCellQuadrature<dim> &rule,
                          const std::vector<Point<dim>> &points,
                          std::vector<double>           &values) {
-      typename ProblemData<dim>::ExactValues               exact;
       const typename DoFHandler<dim>::active_cell_iterator solution_cell(
         &dof_handler.get_triangulation(),
         cell->level(),
@@ -242,11 +280,9 @@ namespace membranes
       std::array<double, GeometryInfo<dim>::vertices_per_cell> vertex_values;
       for (const unsigned int v : cell->vertex_indices())
         vertex_values[v] = dual_mesh.lambda_h_value(solution_cell, v, lambda_h);
-      data.set_gradient_step(1e-4 * cell->diameter());
-      data.exact_solution_list(points, exact);
-      values.resize(points.size());
+      data.exact_action_list(points, values);
       for (unsigned int q = 0; q < points.size(); ++q)
-        values[q] = exact.lambda[q] - vertex_values[rule.vertex_of_point(q)];
+        values[q] -= vertex_values[rule.vertex_of_point(q)];
     };
     // λ − λ_h varies by O(h) on a cell where λ is smooth, and by the jump
     // where λ jumps (λ_h between the values on either side).
