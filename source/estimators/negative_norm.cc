@@ -61,6 +61,38 @@ namespace membranes
       std::array<typename Triangulation<dim>::cell_iterator, 2> matrix_cells;
       std::array<FullMatrix<double>, 2>                         matrices;
       unsigned int                                              next_matrix = 0;
+
+      /**
+       * The H¹ inner product ∫_K ∇φ_i·∇φ_j + φ_i φ_j on @p cell into
+       * @p cell_matrix (zero on entry): that of matrices if @p cell is a
+       * translate of one of matrix_cells, otherwise by the Gauss rule of
+       * fe_values, then kept in place of the older of the two.
+       */
+      template <typename CellIterator>
+      void
+      cell_matrix(const CellIterator &cell, FullMatrix<double> &cell_matrix)
+      {
+        const typename Triangulation<dim>::cell_iterator tria_cell(cell);
+        for (unsigned int k = 0; k < matrix_cells.size(); ++k)
+          if (matrix_cells[k].state() == IteratorState::valid &&
+              tria_cell->is_translation_of(matrix_cells[k]))
+            {
+              cell_matrix = matrices[k];
+              return;
+            }
+        fe_values.reinit(cell);
+        const unsigned int n_dofs = cell_matrix.m();
+        for (const unsigned int q : fe_values.quadrature_point_indices())
+          for (unsigned int i = 0; i < n_dofs; ++i)
+            for (unsigned int j = 0; j < n_dofs; ++j)
+              cell_matrix(i, j) +=
+                (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) +
+                 fe_values.shape_value(i, q) * fe_values.shape_value(j, q)) *
+                fe_values.JxW(q);
+        matrix_cells[next_matrix] = tria_cell;
+        matrices[next_matrix]     = cell_matrix;
+        next_matrix ^= 1;
+      }
     };
   } // namespace
 
@@ -123,35 +155,7 @@ namespace membranes
         copy.dof_indices.resize(n_dofs);
         cell->get_dof_indices(copy.dof_indices);
 
-        // The cell matrix of a translate of one of the last two cells is
-        // theirs (RieszScratch::matrices).
-        const typename Triangulation<dim>::cell_iterator tria_cell(cell);
-        const auto                                       same =
-          std::find_if(scratch.matrix_cells.begin(),
-                       scratch.matrix_cells.end(),
-                       [&](const auto &other) {
-                         return other.state() == IteratorState::valid &&
-                                tria_cell->is_translation_of(other);
-                       });
-        if (same != scratch.matrix_cells.end())
-          copy.cell_matrix =
-            scratch.matrices[same - scratch.matrix_cells.begin()];
-        else
-          {
-            const FEValues<dim> &fe_values = scratch.fe_values;
-            scratch.fe_values.reinit(cell);
-            for (const unsigned int q : fe_values.quadrature_point_indices())
-              for (unsigned int i = 0; i < n_dofs; ++i)
-                for (unsigned int j = 0; j < n_dofs; ++j)
-                  copy.cell_matrix(i, j) +=
-                    (fe_values.shape_grad(i, q) * fe_values.shape_grad(j, q) +
-                     fe_values.shape_value(i, q) *
-                       fe_values.shape_value(j, q)) *
-                    fe_values.JxW(q);
-            scratch.matrix_cells[scratch.next_matrix] = tria_cell;
-            scratch.matrices[scratch.next_matrix]     = copy.cell_matrix;
-            scratch.next_matrix ^= 1;
-          }
+        scratch.cell_matrix(cell, copy.cell_matrix);
 
         scratch.density_values.reinit(cell);
         rho(cell,
