@@ -215,7 +215,7 @@ namespace
       action.reinit(problem);
       active_set.reinit(problem);
       ActiveSetSolver<dim> solver(
-        parameters.solver, discretization, data, pcout, timer, MPI_COMM_WORLD);
+        parameters.solver, data, pcout, timer, MPI_COMM_WORLD);
       solver.setup(problem, dof_handler);
       solution.reinit(std::vector<IndexSet>(2, owned), MPI_COMM_WORLD);
       solver.solve(problem, action, solution, active_set);

@@ -30,7 +30,6 @@ namespace membranes
     , active_set(parameters.solver, data, mpi_communicator)
     , action(data)
     , active_set_solver(parameters.solver,
-                        discretization,
                         data,
                         pcout,
                         computing_timer,

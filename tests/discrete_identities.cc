@@ -228,12 +228,7 @@ namespace
       , discrete_problem(discretization, data)
       , action(data)
       , active_set(parameters.solver, data, mpi_communicator)
-      , solver(parameters.solver,
-               discretization,
-               data,
-               pcout,
-               timer,
-               mpi_communicator)
+      , solver(parameters.solver, data, pcout, timer, mpi_communicator)
       , flux_reconstruction(discretization, data)
     {
       make_mesh(*triangulation);

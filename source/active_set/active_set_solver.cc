@@ -34,18 +34,15 @@ namespace membranes
      */
     template <int dim>
     std::unique_ptr<ActiveSetSystem<dim>>
-    make_active_set_system(const Parameters::Solver  &parameters,
-                           const Discretization<dim> &discretization,
-                           const ProblemData<dim>    &data,
-                           const MPI_Comm             mpi_communicator)
+    make_active_set_system(const Parameters::Solver &parameters,
+                           const ProblemData<dim>   &data,
+                           const MPI_Comm            mpi_communicator)
     {
       if (parameters.method == Parameters::SolverMethod::coupled)
         return std::make_unique<CoupledSystem<dim>>(parameters,
-                                                    discretization,
                                                     data,
                                                     mpi_communicator);
       return std::make_unique<DecoupledSystem<dim>>(parameters,
-                                                    discretization,
                                                     data,
                                                     mpi_communicator);
     }
@@ -54,23 +51,18 @@ namespace membranes
 
 
   template <int dim>
-  ActiveSetSolver<dim>::ActiveSetSolver(
-    const Parameters::Solver  &parameters,
-    const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data,
-    const ConditionalOStream  &pcout,
-    TimerOutput               &timer,
-    const MPI_Comm             mpi_communicator)
+  ActiveSetSolver<dim>::ActiveSetSolver(const Parameters::Solver &parameters,
+                                        const ProblemData<dim>   &data,
+                                        const ConditionalOStream &pcout,
+                                        TimerOutput              &timer,
+                                        const MPI_Comm mpi_communicator)
     : parameters(parameters)
     , data(data)
     , pcout(pcout)
     , timer(timer)
     , mpi_communicator(mpi_communicator)
     , prediction(parameters, data)
-    , system(make_active_set_system(parameters,
-                                    discretization,
-                                    data,
-                                    mpi_communicator))
+    , system(make_active_set_system(parameters, data, mpi_communicator))
   {}
 
 

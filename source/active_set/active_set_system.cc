@@ -5,14 +5,11 @@
 namespace membranes
 {
   template <int dim>
-  ActiveSetSystem<dim>::ActiveSetSystem(
-    const std::string         &method,
-    const Parameters::Solver  &parameters,
-    const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data,
-    const MPI_Comm             mpi_communicator)
-    : discretization(discretization)
-    , data(data)
+  ActiveSetSystem<dim>::ActiveSetSystem(const std::string        &method,
+                                        const Parameters::Solver &parameters,
+                                        const ProblemData<dim>   &data,
+                                        const MPI_Comm mpi_communicator)
+    : data(data)
     , mpi_communicator(mpi_communicator)
     , linear_solver(parameters.linear_solver, mpi_communicator)
     , method(method)

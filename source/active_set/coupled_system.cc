@@ -10,15 +10,10 @@
 namespace membranes
 {
   template <int dim>
-  CoupledSystem<dim>::CoupledSystem(const Parameters::Solver  &parameters,
-                                    const Discretization<dim> &discretization,
-                                    const ProblemData<dim>    &data,
-                                    const MPI_Comm             mpi_communicator)
-    : ActiveSetSystem<dim>("coupled",
-                           parameters,
-                           discretization,
-                           data,
-                           mpi_communicator)
+  CoupledSystem<dim>::CoupledSystem(const Parameters::Solver &parameters,
+                                    const ProblemData<dim>   &data,
+                                    const MPI_Comm            mpi_communicator)
+    : ActiveSetSystem<dim>("coupled", parameters, data, mpi_communicator)
   {}
 
 

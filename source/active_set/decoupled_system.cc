@@ -4,16 +4,10 @@
 namespace membranes
 {
   template <int dim>
-  DecoupledSystem<dim>::DecoupledSystem(
-    const Parameters::Solver  &parameters,
-    const Discretization<dim> &discretization,
-    const ProblemData<dim>    &data,
-    const MPI_Comm             mpi_communicator)
-    : ActiveSetSystem<dim>("decoupled",
-                           parameters,
-                           discretization,
-                           data,
-                           mpi_communicator)
+  DecoupledSystem<dim>::DecoupledSystem(const Parameters::Solver &parameters,
+                                        const ProblemData<dim>   &data,
+                                        const MPI_Comm mpi_communicator)
+    : ActiveSetSystem<dim>("decoupled", parameters, data, mpi_communicator)
     , s_solved(false)
     , hierarchy_iterations(0)
   {}

@@ -17,6 +17,17 @@ endfunction()
 # the cycle, or stops elsewhere than at the solution.
 membranes_unit_test(active_set_cycles)
 
+# What the history takes for a cycle (ActiveSetHistory): a set visited
+# before over all processes, on one and on two processes. Catches: a
+# fingerprint of the size of the set alone (a new set of the same size taken
+# for a cycle), or of a process's own part alone.
+membranes_unit_test(active_set_history)
+add_test(NAME active_set_history_np2
+  COMMAND ${DEAL_II_MPIEXEC} ${DEAL_II_MPIEXEC_NUMPROC_FLAG} 2
+          $<TARGET_FILE:active_set_history>)
+set_tests_properties(active_set_history_np2 PROPERTIES PROCESSORS 2
+  ENVIRONMENT "${MPI_ROOT_ENVIRONMENT}" LABELS quick)
+
 # The discrete identities on three tiny meshes (2x2 Q1, one hanging node,
 # four triangles) against values computed by hand: d_a, c_a, lambda_a of
 # (4.5) from both membranes and their weighted mean, Prop. 12, (4.8),

@@ -163,7 +163,11 @@ namespace membranes
    * the size of the forces of the obstacle problem for w at a.) After a
    * solve, W_a = 0 on A and λ_a = 0 off A, up to round-off, so the test
    * keeps an active vertex iff λ_a > 0 and activates an inactive one iff
-   * W_a < 0; c_a only matters for the initial active set of a mesh. Where
+   * W_a < 0: the iterates of the plain method do not depend on c_a. It
+   * matters where neither holds, in the initial active set of a mesh (from
+   * the transferred iterate) and on the predicted iterate
+   * (ActiveSetPrediction), and in the band below, which reads λ_a in units
+   * of c_a U_∞. Where
    * both are zero in exact arithmetic (a degenerate vertex: the membranes
    * touch without pressing on each other), the sign of the test is the
    * sign of round-off, a vertex may flip at every iteration, and the plain

@@ -168,12 +168,11 @@ namespace membranes
      * The phases of the method are timed in the sections "assembly" and
      * "solve" of @p timer.
      */
-    ActiveSetSolver(const Parameters::Solver  &parameters,
-                    const Discretization<dim> &discretization,
-                    const ProblemData<dim>    &data,
-                    const ConditionalOStream  &pcout,
-                    TimerOutput               &timer,
-                    const MPI_Comm             mpi_communicator);
+    ActiveSetSolver(const Parameters::Solver &parameters,
+                    const ProblemData<dim>   &data,
+                    const ConditionalOStream &pcout,
+                    TimerOutput              &timer,
+                    const MPI_Comm            mpi_communicator);
 
     ~ActiveSetSolver();
 

@@ -146,16 +146,14 @@ namespace membranes
                  const IndexSet                               &active_set,
                  const std::function<void(const MatrixRow &)> &row_function);
 
-    ActiveSetSystem(const std::string         &method,
-                    const Parameters::Solver  &parameters,
-                    const Discretization<dim> &discretization,
-                    const ProblemData<dim>    &data,
-                    const MPI_Comm             mpi_communicator);
+    ActiveSetSystem(const std::string        &method,
+                    const Parameters::Solver &parameters,
+                    const ProblemData<dim>   &data,
+                    const MPI_Comm            mpi_communicator);
 
-    const Discretization<dim> &discretization;
-    const ProblemData<dim>    &data;
-    const MPI_Comm             mpi_communicator;
-    LinearSolver               linear_solver;
+    const ProblemData<dim> &data;
+    const MPI_Comm          mpi_communicator;
+    LinearSolver            linear_solver;
 
   private:
     const std::string method;

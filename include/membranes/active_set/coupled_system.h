@@ -48,10 +48,9 @@ namespace membranes
     using VectorType      = typename ActiveSetSystem<dim>::VectorType;
     using BlockVectorType = typename ActiveSetSystem<dim>::BlockVectorType;
 
-    CoupledSystem(const Parameters::Solver  &parameters,
-                  const Discretization<dim> &discretization,
-                  const ProblemData<dim>    &data,
-                  const MPI_Comm             mpi_communicator);
+    CoupledSystem(const Parameters::Solver &parameters,
+                  const ProblemData<dim>   &data,
+                  const MPI_Comm            mpi_communicator);
 
     /**
      * The constraints of both membranes of @p problem in the numbering of

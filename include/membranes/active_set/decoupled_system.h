@@ -57,8 +57,9 @@ namespace membranes
    * solution. Both solves start with the constrained entries zero, as the
    * solution of the condensed system has them (step-55 does the same), and
    * the constraints of each membrane give U1 and U2 their values there.
-   * ActiveSetSolver computes λ_a by (4.5), and ActiveSet the next active
-   * set and the KKT residual, from it exactly as for the coupled system:
+   * ActiveSetSolver computes λ_a by (4.5), ActiveSet the next active set
+   * and KKTDefects the KKT residual, from it exactly as for the coupled
+   * system:
    * the test Λ_a − c_a W_a > 0 with c_a = μ̄ ∫|∇φ_a|²/d_a is the active set
    * test of this obstacle problem, whose diagonal is μ̄ A_aa.
    *
@@ -98,10 +99,9 @@ namespace membranes
     using VectorType      = typename ActiveSetSystem<dim>::VectorType;
     using BlockVectorType = typename ActiveSetSystem<dim>::BlockVectorType;
 
-    DecoupledSystem(const Parameters::Solver  &parameters,
-                    const Discretization<dim> &discretization,
-                    const ProblemData<dim>    &data,
-                    const MPI_Comm             mpi_communicator);
+    DecoupledSystem(const Parameters::Solver &parameters,
+                    const ProblemData<dim>   &data,
+                    const MPI_Comm            mpi_communicator);
 
     /** The vectors S and W on the mesh of @p problem. */
     void
