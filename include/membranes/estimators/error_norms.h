@@ -32,9 +32,10 @@ namespace membranes
    * one on ω; where λ does not vanish on ∂ω, the strip alone contributes
    * ‖λ‖_{L2(ω∖ω_h)} = O(h^{1/2}) to it.
    *
-   * All six in one pass over the cells, with one call of the exact
-   * solution per cell (ProblemData::exact_solution_list(), compiled: u1,
-   * u2, their gradients and λ together) at the points of two rules:
+   * Those of the six that `Exact solution/Norms` names, in one pass over
+   * the cells, with one call of the exact solution per cell
+   * (ProblemData::exact_solution_list(), compiled: u1, u2, their gradients
+   * and λ together) at the points of two rules:
    *
    * - the displacement errors: the cell rule of the Discretization
    *   (QGaussSimplex(3) on triangles, QGauss(3) on quadrilaterals), exact
