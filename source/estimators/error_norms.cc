@@ -264,8 +264,8 @@ namespace membranes
 
     /** Whether @p exact names any of the error columns @p names. */
     bool
-    computes_any(const Parameters::ExactSolution          &exact,
-                 const std::initializer_list<const char *> names)
+    computes_one_of(const Parameters::ExactSolution          &exact,
+                    const std::initializer_list<const char *> names)
     {
       return std::any_of(names.begin(), names.end(), [&](const char *name) {
         return exact.computes(name);
@@ -332,12 +332,12 @@ namespace membranes
                            const Parameters::ExactSolution &exact_parameters,
                            const MPI_Comm mpi_communicator) const
   {
-    const bool displacements = computes_any(
+    const bool displacements = computes_one_of(
       exact_parameters,
       {"err_u1_H1", "err_u2_H1", "err_u1_L2", "err_u2_L2", "err_energy"});
     const bool action =
-      computes_any(exact_parameters,
-                   {"err_lambda_L2", "err_lambda_L2_omega_h"});
+      computes_one_of(exact_parameters,
+                      {"err_lambda_L2", "err_lambda_L2_omega_h"});
     if (!displacements && !action)
       return {};
 
