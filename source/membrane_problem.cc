@@ -277,12 +277,9 @@ namespace membranes
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
     // (benchmarks/README.md, "The H^-1 norm of the action").
     if (exact.computes("err_lambda_Hm1"))
-      errors.lambda_Hm1 = NegativeNorm<dim>(discretization)
-                            .lambda_error(dof_handler,
-                                          dual_mesh,
-                                          lambda_h,
-                                          data,
-                                          mpi_communicator);
+      errors.lambda_Hm1 =
+        NegativeNorm<dim>(discretization)
+          .lambda_error(dof_handler, dual_mesh, lambda_h, data);
     return errors;
   }
 

@@ -61,8 +61,7 @@ namespace
           values[q] =
             std::sin(M_PI * points[q][0]) * std::sin(M_PI * points[q][1]);
       },
-      std::numeric_limits<double>::infinity(),
-      MPI_COMM_WORLD);
+      std::numeric_limits<double>::infinity());
   }
 
 
@@ -94,8 +93,7 @@ namespace
             values[q] = lambda(points[q]) - (interior ? lambda(a) : 0.);
           }
       },
-      jump,
-      MPI_COMM_WORLD);
+      jump);
   }
 } // namespace
 

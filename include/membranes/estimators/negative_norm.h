@@ -9,6 +9,7 @@
 #include <functional>
 #include <membranes/dual_mesh/dual_cell_quadrature.h>
 #include <membranes/dual_mesh/dual_mesh.h>
+#include <membranes/estimators/riesz_operator.h>
 #include <membranes/mesh/discretization.h>
 #include <membranes/scene/problem_data.h>
 #include <vector>
@@ -42,6 +43,14 @@ namespace membranes
    * rule on each piece, and on the cells where ρ jumps by more than a
    * threshold (an exact λ that jumps across a curve inside the pieces) the
    * same rule on each of the 4^k parts of every piece.
+   *
+   * The system (A + M) Z = F of degree p has twice the unknowns of the
+   * solution and is solved without its matrix: RieszOperator applies A + M
+   * cell by cell, and RieszMultigrid preconditions CG by one p-multigrid
+   * V-cycle down to the space of degree 1 on the same mesh, whose matrix
+   * (the only one assembled) takes algebraic multigrid. The error phase of
+   * a cycle thus holds vectors of degree p and the matrices of degree 1,
+   * not a matrix of degree p and its algebraic hierarchy.
    */
   template <int dim>
   class NegativeNorm
@@ -76,8 +85,7 @@ namespace membranes
     double
     norm(const Triangulation<dim> &triangulation,
          const Density            &rho,
-         const double              jump,
-         const MPI_Comm            mpi_communicator) const;
+         const double              jump) const;
 
     /**
      * ‖λ − λ_h‖_{H^{-1}(ω)} with the exact λ of @p data and λ_h of
@@ -91,25 +99,27 @@ namespace membranes
     lambda_error(const DoFHandler<dim>               &dof_handler,
                  const DualMesh<dim>                 &dual_mesh,
                  const TrilinosWrappers::MPI::Vector &lambda_h,
-                 const ProblemData<dim>              &data,
-                 const MPI_Comm                       mpi_communicator) const;
+                 const ProblemData<dim>              &data) const;
 
   private:
+    using VectorType = typename RieszOperator<dim>::VectorType;
+
     /**
-     * The H¹ inner product (A + M) of the representative's space of
-     * @p dof_handler and F_j = ∫ ρ φ_j, condensed with @p constraints.
+     * F_j = ∫ ρ φ_j on the representative's space of @p dof_handler,
+     * condensed with @p constraints, into @p rhs.
      */
     void
-    assemble(const DoFHandler<dim>           &dof_handler,
-             const AffineConstraints<double> &constraints,
-             const Density                   &rho,
-             const double                     jump,
-             TrilinosWrappers::SparseMatrix  &matrix,
-             TrilinosWrappers::MPI::Vector   &rhs) const;
+    assemble_density(const DoFHandler<dim>           &dof_handler,
+                     const AffineConstraints<double> &constraints,
+                     const Density                   &rho,
+                     const double                     jump,
+                     VectorType                      &rhs) const;
 
     const Discretization<dim>                &discretization;
     const std::unique_ptr<FiniteElement<dim>> fe;
+    const std::unique_ptr<FiniteElement<dim>> linear_fe;
     const Quadrature<dim>                     cell_quadrature;
+    const Quadrature<dim>                     linear_quadrature;
     const DualCellQuadrature<dim>             density_quadrature;
     const DualCellQuadrature<dim>             jump_quadrature;
   };
