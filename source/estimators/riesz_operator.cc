@@ -54,6 +54,15 @@ namespace membranes
 
 
   template <int dim>
+  const std::shared_ptr<const Utilities::MPI::Partitioner> &
+  RieszOperator<dim>::get_partitioner() const
+  {
+    return matrix_free.get_vector_partitioner();
+  }
+
+
+
+  template <int dim>
   void
   RieszOperator<dim>::integrate_cell(Integrator &integrator) const
   {

@@ -3,12 +3,10 @@
 
 #include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
-#include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/diagonal_matrix.h>
-#include <deal.II/lac/precondition.h>
 #include <deal.II/lac/trilinos_precondition.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
+#include <membranes/estimators/linear_embedding.h>
 #include <membranes/estimators/riesz_operator.h>
 
 namespace membranes
@@ -22,22 +20,21 @@ namespace membranes
    * deal.II's step-75 with a single p-step). One application is the
    * V-cycle
    *
-   *   x = S b,   x += P (A_1)^{-1}_{AMG} Pᵀ (b − (A + M) x),   x = S-step,
+   *   x = ω D⁻¹ b,   x += P (A_1)^{-1}_{AMG} Pᵀ (b − (A + M) x),
+   *   x += ω D⁻¹ (b − (A + M) x),
    *
-   * with S Chebyshev smoothing of degree 1 on the diagonal D of A + M (a
-   * damped Jacobi step, its damping set by the largest eigenvalue of
-   * D⁻¹(A + M), which ten CG iterations estimate), P the embedding of V_1
-   * into V_p (the nodal interpolation of a function of V_1 at the nodes of
-   * V_p, exact because V_1 ⊂ V_p), and one V-cycle of algebraic multigrid
-   * on the matrix A_1 of A + M on V_1. Pre- and post-smoothing are the same
-   * polynomial and Pᵀ is the transpose of P, so the preconditioner is
-   * symmetric and CG applies.
+   * with damped Jacobi smoothing on the diagonal D of A + M, P the
+   * embedding of V_1 into V_p (LinearEmbedding) and one V-cycle of
+   * algebraic multigrid on the matrix A_1 of A + M on V_1, the only matrix
+   * assembled (by the owner of its AMG): it has the rows of one scalar
+   * field of the solution. Pre- and post-smoothing are the same and Pᵀ is
+   * the transpose of P, so the preconditioner is symmetric and CG applies.
    *
-   * Only A_1 and P are assembled: A_1 has the rows of a scalar field of the
-   * solution, P at most four (P1: three) entries a row of V_p where no
-   * hanging node constrains V_1. deal.II 9.4 has the transfer between the
-   * two spaces too (MGTwoLevelTransfer), but it takes longer to set up than
-   * this whole solve.
+   * The damping ω = 1 / (0.55 λ̂) is that of deal.II's PreconditionChebyshev
+   * of degree 1 on [λ̂/10, λ̂], for an estimate λ̂ of the largest eigenvalue
+   * of D⁻¹(A + M). Chebyshev smoothing of degree 2 to 4 saves at most one
+   * CG iteration of the six to eight at 526 338 DoFs, each at the price of
+   * two more products with A + M per V-cycle.
    */
   template <int dim>
   class RieszMultigrid : public Subscriptor
@@ -48,33 +45,29 @@ namespace membranes
     /**
      * The preconditioner of @p riesz on @p dof_handler with @p constraints,
      * with the coarse space of @p linear_dof_handler (degree 1, on the
-     * same mesh) with @p linear_constraints, integrated by
-     * @p linear_quadrature on the cells mapped by @p mapping.
+     * same mesh) with @p linear_constraints, on which
+     * @p linear_preconditioner is the AMG of A_1.
      */
-    RieszMultigrid(const RieszOperator<dim>        &riesz,
-                   const DoFHandler<dim>           &dof_handler,
-                   const AffineConstraints<double> &constraints,
-                   const DoFHandler<dim>           &linear_dof_handler,
-                   const AffineConstraints<double> &linear_constraints,
-                   const Mapping<dim>              &mapping,
-                   const Quadrature<dim>           &linear_quadrature);
+    RieszMultigrid(
+      const RieszOperator<dim>                &riesz,
+      const DoFHandler<dim>                   &dof_handler,
+      const AffineConstraints<double>         &constraints,
+      const DoFHandler<dim>                   &linear_dof_handler,
+      const AffineConstraints<double>         &linear_constraints,
+      const TrilinosWrappers::PreconditionAMG &linear_preconditioner);
 
     /** @p dst = one V-cycle applied to @p src. */
     void
     vmult(VectorType &dst, const VectorType &src) const;
 
   private:
-    using Smoother = PreconditionChebyshev<RieszOperator<dim>,
-                                           VectorType,
-                                           DiagonalMatrix<VectorType>>;
-
-    const RieszOperator<dim>         &riesz;
-    Smoother                          smoother;
-    TrilinosWrappers::SparseMatrix    prolongation;
-    TrilinosWrappers::SparseMatrix    linear_matrix;
-    TrilinosWrappers::PreconditionAMG amg;
-    mutable VectorType                residual;
-    mutable VectorType                linear_residual, linear_correction;
+    const RieszOperator<dim>                &riesz;
+    const TrilinosWrappers::PreconditionAMG &linear_preconditioner;
+    DiagonalMatrix<VectorType>               inverse_diagonal;
+    double                                   damping;
+    const LinearEmbedding<dim>               embedding;
+    mutable VectorType                       residual;
+    mutable VectorType                       linear_residual, linear_correction;
   };
 } // namespace membranes
 

@@ -28,7 +28,7 @@ namespace membranes
    * matrix would.
    *
    * It serves the p-multigrid of NegativeNorm both as the operator of the
-   * representative's space (vmult(), and the diagonal of the Chebyshev
+   * representative's space (vmult(), and the diagonal of the Jacobi
    * smoother) and on the space of degree 1, whose matrix it assembles for
    * the algebraic multigrid of the coarse level.
    */
@@ -58,6 +58,10 @@ namespace membranes
     /** @p vector with the layout (owned and ghost DoFs) of the cell loop. */
     void
     initialize_dof_vector(VectorType &vector) const;
+
+    /** That layout. */
+    const std::shared_ptr<const Utilities::MPI::Partitioner> &
+    get_partitioner() const;
 
     /** @p dst = (A + M) @p src. */
     void
