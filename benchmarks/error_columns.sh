@@ -70,7 +70,8 @@ for name, (scene, columns) in labels.items():
     errors = f"{median('time_errors_s'):.2f}" if "time_errors_s" in rows[0] \
         and rows[0]["time_errors_s"] else "–"
     memory = median("memory_mb")
-    print(f"| {scene} | {columns} | {dofs:,} | {median('wall_time_s'):.2f} | "
-          f"{errors} | {memory:,.0f} | {memory * 2**20 / dofs:.0f} |"
-          .replace(",", " "))
+    grouped = lambda value: f"{value:,.0f}".replace(",", " ")
+    print(f"| {scene} | {columns} | {grouped(dofs)} | "
+          f"{median('wall_time_s'):.2f} | {errors} | {grouped(memory)} | "
+          f"{memory * 2**20 / dofs:.0f} |")
 EOF
