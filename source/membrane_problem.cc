@@ -277,9 +277,12 @@ namespace membranes
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
     // (benchmarks/README.md, "The H^-1 norm of the action").
     if (exact.computes("err_lambda_Hm1"))
-      errors.lambda_Hm1 =
-        NegativeNorm<dim>(discretization)
-          .lambda_error(dof_handler, dual_mesh, lambda_h, data);
+      errors.lambda_Hm1 = NegativeNorm<dim>(discretization)
+                            .lambda_error(dof_handler,
+                                          discrete_problem.laplace_matrix(),
+                                          dual_mesh,
+                                          lambda_h,
+                                          data);
     return errors;
   }
 

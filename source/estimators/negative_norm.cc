@@ -84,14 +84,9 @@ namespace membranes
     , fe(discretization.cell_type == Parameters::CellType::triangle ?
            std::unique_ptr<FiniteElement<dim>>(new FE_SimplexP<dim>(degree)) :
            std::make_unique<FE_Q<dim>>(degree))
-    , linear_fe(discretization.cell_type == Parameters::CellType::triangle ?
-                  std::unique_ptr<FiniteElement<dim>>(new FE_SimplexP<dim>(1)) :
-                  std::make_unique<FE_Q<dim>>(1))
     , cell_quadrature(
         fe->reference_cell().template get_gauss_type_quadrature<dim>(degree +
                                                                      1))
-    , linear_quadrature(
-        fe->reference_cell().template get_gauss_type_quadrature<dim>(2))
     , density_quadrature(fe->reference_cell(), 2)
     , jump_quadrature(fe->reference_cell(),
                       QIteratedSimplex<dim>(QGaussSimplex<dim>(2),
@@ -172,30 +167,22 @@ namespace membranes
 
   template <int dim>
   double
-  NegativeNorm<dim>::norm(const Triangulation<dim> &triangulation,
-                          const Density            &rho,
-                          const double              jump) const
+  NegativeNorm<dim>::norm(const DoFHandler<dim> &linear_dof_handler,
+                          const TrilinosWrappers::SparseMatrix &linear_matrix,
+                          const Density                        &rho,
+                          const double                          jump) const
   {
-    // The space of degree 1, the coarse level of the multigrid, zero on ∂ω,
-    // and the AMG of its matrix A_1 (the same cell integral), first: the
+    // The coarse level, zero on ∂ω, and the AMG of its matrix, first: the
     // transient memory of the AMG setup is the peak of this phase, and
     // nothing of degree p exists yet.
-    DoFHandler<dim> linear_dof_handler(triangulation);
-    linear_dof_handler.distribute_dofs(*linear_fe);
+    const Triangulation<dim> &triangulation =
+      linear_dof_handler.get_triangulation();
     const AffineConstraints<double> linear_constraints =
       riesz_constraints(linear_dof_handler);
-    TrilinosWrappers::SparseMatrix    linear_matrix;
-    TrilinosWrappers::PreconditionAMG linear_preconditioner;
-    {
-      RieszOperator<dim>(*discretization.mapping,
-                         linear_dof_handler,
-                         linear_constraints,
-                         linear_quadrature)
-        .compute_matrix(linear_matrix);
-      TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
-      amg_data.elliptic = true;
-      linear_preconditioner.initialize(linear_matrix, amg_data);
-    }
+    TrilinosWrappers::PreconditionAMG                 linear_preconditioner;
+    TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
+    amg_data.elliptic = true;
+    linear_preconditioner.initialize(linear_matrix, amg_data);
 
     // The space of z_h, of degree p, zero on ∂ω. Its operator is
     // matrix-free: neither its matrix nor an algebraic hierarchy of it is
@@ -243,10 +230,12 @@ namespace membranes
 
   template <int dim>
   double
-  NegativeNorm<dim>::lambda_error(const DoFHandler<dim> &dof_handler,
-                                  const DualMesh<dim>   &dual_mesh,
-                                  const TrilinosWrappers::MPI::Vector &lambda_h,
-                                  const ProblemData<dim> &data) const
+  NegativeNorm<dim>::lambda_error(
+    const DoFHandler<dim>                &dof_handler,
+    const TrilinosWrappers::SparseMatrix &laplace_matrix,
+    const DualMesh<dim>                  &dual_mesh,
+    const TrilinosWrappers::MPI::Vector  &lambda_h,
+    const ProblemData<dim>               &data) const
   {
     // λ_h on the piece K ∩ D_a of each point, read on the cell of the mesh
     // of the solution that is the same cell of the triangulation, and the
@@ -271,7 +260,7 @@ namespace membranes
     // λ − λ_h varies by O(h) on a cell where λ is smooth, and by the jump
     // where λ jumps (λ_h between the values on either side).
     const double jump = lambda_jump_fraction * lambda_h.linfty_norm();
-    return norm(dof_handler.get_triangulation(), rho, jump);
+    return norm(dof_handler, laplace_matrix, rho, jump);
   }
 
 

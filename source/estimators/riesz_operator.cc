@@ -1,6 +1,3 @@
-#include <deal.II/dofs/dof_tools.h>
-#include <deal.II/lac/dynamic_sparsity_pattern.h>
-#include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/matrix_free/tools.h>
 #include <membranes/estimators/riesz_operator.h>
 
@@ -127,32 +124,6 @@ namespace membranes
                                       this);
     for (double &entry : inverse_diagonal)
       entry = (entry > 0. ? 1. / entry : 1.);
-  }
-
-
-
-  template <int dim>
-  void
-  RieszOperator<dim>::compute_matrix(
-    TrilinosWrappers::SparseMatrix &matrix) const
-  {
-    const DoFHandler<dim> &dof_handler = matrix_free.get_dof_handler();
-    const IndexSet        &owned       = dof_handler.locally_owned_dofs();
-    IndexSet               relevant;
-    DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
-    const MPI_Comm communicator =
-      dof_handler.get_triangulation().get_communicator();
-    {
-      DynamicSparsityPattern dsp(relevant);
-      DoFTools::make_sparsity_pattern(dof_handler, dsp, constraints, false);
-      SparsityTools::distribute_sparsity_pattern(dsp,
-                                                 owned,
-                                                 communicator,
-                                                 relevant);
-      matrix.reinit(owned, owned, dsp, communicator);
-    }
-    MatrixFreeTools::compute_matrix(
-      matrix_free, constraints, matrix, &RieszOperator::integrate_cell, this);
   }
 
 

@@ -46,10 +46,11 @@ namespace membranes
    * The system (A + M) Z = F of degree p has twice the unknowns of the
    * solution and is solved without its matrix: RieszOperator applies A + M
    * cell by cell, and RieszMultigrid preconditions CG by one p-multigrid
-   * V-cycle down to the space of degree 1 on the same mesh, whose matrix
-   * (the only one assembled) takes algebraic multigrid. The error phase of
-   * a cycle thus holds vectors of degree p and the matrices of degree 1,
-   * not a matrix of degree p and its algebraic hierarchy.
+   * V-cycle down to the space of degree 1 on the same mesh, the space of
+   * the solution, on which algebraic multigrid of the Laplacian that the
+   * method assembled anyway solves. The error phase of a cycle thus holds
+   * vectors of degree p and an AMG hierarchy of degree 1, and assembles no
+   * matrix.
    */
   template <int dim>
   class NegativeNorm
@@ -77,14 +78,22 @@ namespace membranes
                  const unsigned int         jump_subdivisions = 4);
 
     /**
-     * ‖ρ‖_{H^{-1}(ω)} by ‖z_h‖_{H¹(ω)}, on the mesh @p triangulation; the
-     * cells on which the values of ρ at the points of the three-point rule
-     * differ by more than @p jump take the composite rule.
+     * ‖ρ‖_{H^{-1}(ω)} by ‖z_h‖_{H¹(ω)}, on the mesh of
+     * @p linear_dof_handler, the space of degree 1 (P1/Q1) on it: the
+     * coarse level of the multigrid, on which the AMG of @p linear_matrix
+     * solves. That matrix need only be spectrally equivalent to A + M on
+     * the space of degree 1 with zero boundary values: the Laplacian of
+     * the mesh, condensed with its hanging node and boundary constraints
+     * (DiscreteProblem::laplace_matrix()), is (A ≤ A + M ≤ (1 + C_P) A by
+     * Poincaré's inequality). The cells on which the values of ρ at the
+     * points of the three-point rule differ by more than @p jump take the
+     * composite rule.
      */
     double
-    norm(const Triangulation<dim> &triangulation,
-         const Density            &rho,
-         const double              jump) const;
+    norm(const DoFHandler<dim>                &linear_dof_handler,
+         const TrilinosWrappers::SparseMatrix &linear_matrix,
+         const Density                        &rho,
+         const double                          jump) const;
 
     /**
      * ‖λ − λ_h‖_{H^{-1}(ω)} with the exact λ of @p data and λ_h of
@@ -92,13 +101,16 @@ namespace membranes
      * @p dual_mesh, and λ_h = 0 on the strip ω ∖ ω_h, as in the L²(ω)
      * error (ErrorNorms). The composite rule takes the cells where λ − λ_h
      * varies by more than a tenth of max |λ_h|: where λ jumps, not where it
-     * is smooth, on which it varies by O(h).
+     * is smooth, on which it varies by O(h). @p dof_handler is the scalar
+     * P1/Q1 space of the solution and @p laplace_matrix its Laplacian A
+     * (DiscreteProblem::laplace_matrix()): the coarse level of norm().
      */
     double
-    lambda_error(const DoFHandler<dim>               &dof_handler,
-                 const DualMesh<dim>                 &dual_mesh,
-                 const TrilinosWrappers::MPI::Vector &lambda_h,
-                 const ProblemData<dim>              &data) const;
+    lambda_error(const DoFHandler<dim>                &dof_handler,
+                 const TrilinosWrappers::SparseMatrix &laplace_matrix,
+                 const DualMesh<dim>                  &dual_mesh,
+                 const TrilinosWrappers::MPI::Vector  &lambda_h,
+                 const ProblemData<dim>               &data) const;
 
   private:
     using VectorType = typename RieszOperator<dim>::VectorType;
@@ -116,9 +128,7 @@ namespace membranes
 
     const Discretization<dim>                &discretization;
     const std::unique_ptr<FiniteElement<dim>> fe;
-    const std::unique_ptr<FiniteElement<dim>> linear_fe;
     const Quadrature<dim>                     cell_quadrature;
-    const Quadrature<dim>                     linear_quadrature;
     const DualCellQuadrature<dim>             density_quadrature;
     const DualCellQuadrature<dim>             jump_quadrature;
   };

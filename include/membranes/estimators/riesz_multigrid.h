@@ -25,10 +25,10 @@ namespace membranes
    *
    * with damped Jacobi smoothing on the diagonal D of A + M, P the
    * embedding of V_1 into V_p (LinearEmbedding) and one V-cycle of
-   * algebraic multigrid on the matrix A_1 of A + M on V_1, the only matrix
-   * assembled (by the owner of its AMG): it has the rows of one scalar
-   * field of the solution. Pre- and post-smoothing are the same and Pᵀ is
-   * the transpose of P, so the preconditioner is symmetric and CG applies.
+   * algebraic multigrid on a matrix A_1 of V_1 spectrally equivalent to
+   * A + M there (NegativeNorm::norm() takes the Laplacian of the mesh).
+   * Pre- and post-smoothing are the same and Pᵀ is the transpose of P, so
+   * the preconditioner is symmetric and CG applies.
    *
    * The damping ω = 1 / (0.55 λ̂) is that of deal.II's PreconditionChebyshev
    * of degree 1 on [λ̂/10, λ̂], for an estimate λ̂ of the largest eigenvalue

@@ -6,7 +6,6 @@
 #include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/la_parallel_vector.h>
-#include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/matrix_free.h>
 
@@ -27,10 +26,9 @@ namespace membranes
    * loop, so the operator acts on the unconstrained DoFs, as the condensed
    * matrix would.
    *
-   * It serves the p-multigrid of NegativeNorm both as the operator of the
-   * representative's space (vmult(), and the diagonal of the Jacobi
-   * smoother) and on the space of degree 1, whose matrix it assembles for
-   * the algebraic multigrid of the coarse level.
+   * It serves the p-multigrid of NegativeNorm (RieszMultigrid) as the
+   * operator of the representative's space: vmult(), and the diagonal of
+   * the Jacobi smoother.
    */
   template <int dim>
   class RieszOperator : public Subscriptor
@@ -77,14 +75,6 @@ namespace membranes
      */
     void
     compute_inverse_diagonal(VectorType &inverse_diagonal) const;
-
-    /**
-     * A + M assembled into @p matrix (of the owned DoFs, on the
-     * communicator of the mesh), with one on the diagonal of the
-     * constrained DoFs.
-     */
-    void
-    compute_matrix(TrilinosWrappers::SparseMatrix &matrix) const;
 
   private:
     using Integrator = FEEvaluation<dim, -1, 0, 1, double>;
