@@ -9,7 +9,6 @@ namespace membranes
     const DoFHandler<dim>           &dof_handler,
     const AffineConstraints<double> &constraints,
     const Quadrature<dim>           &quadrature)
-    : constraints(constraints)
   {
     // One thread per process: the sums of the cell loop are then formed in
     // the same order on every run.
@@ -18,25 +17,6 @@ namespace membranes
     data.mapping_update_flags =
       update_values | update_gradients | update_JxW_values;
     matrix_free.reinit(mapping, dof_handler, constraints, quadrature, data);
-  }
-
-
-
-  template <int dim>
-  types::global_dof_index
-  RieszOperator<dim>::m() const
-  {
-    return matrix_free.get_dof_handler().n_dofs();
-  }
-
-
-
-  template <int dim>
-  double
-  RieszOperator<dim>::el(const unsigned int, const unsigned int) const
-  {
-    Assert(false, ExcNotImplemented());
-    return 0;
   }
 
 

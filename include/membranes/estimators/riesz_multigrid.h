@@ -1,7 +1,6 @@
 #ifndef membranes_riesz_multigrid_h
 #define membranes_riesz_multigrid_h
 
-#include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/diagonal_matrix.h>
@@ -37,7 +36,7 @@ namespace membranes
    * two more products with A + M per V-cycle.
    */
   template <int dim>
-  class RieszMultigrid : public Subscriptor
+  class RieszMultigrid
   {
   public:
     using VectorType = typename RieszOperator<dim>::VectorType;

@@ -1,7 +1,6 @@
 #ifndef membranes_riesz_operator_h
 #define membranes_riesz_operator_h
 
-#include <deal.II/base/subscriptor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/mapping.h>
 #include <deal.II/lac/affine_constraints.h>
@@ -31,7 +30,7 @@ namespace membranes
    * the Jacobi smoother.
    */
   template <int dim>
-  class RieszOperator : public Subscriptor
+  class RieszOperator
   {
   public:
     using VectorType = LinearAlgebra::distributed::Vector<double>;
@@ -44,14 +43,6 @@ namespace membranes
                   const DoFHandler<dim>           &dof_handler,
                   const AffineConstraints<double> &constraints,
                   const Quadrature<dim>           &quadrature);
-
-    /** The number of DoFs (rows) of the space. */
-    types::global_dof_index
-    m() const;
-
-    /** Unused entry access that deal.II's smoothers require to compile. */
-    double
-    el(const unsigned int row, const unsigned int column) const;
 
     /** @p vector with the layout (owned and ghost DoFs) of the cell loop. */
     void
@@ -90,8 +81,7 @@ namespace membranes
                 const VectorType                            &src,
                 const std::pair<unsigned int, unsigned int> &range) const;
 
-    const AffineConstraints<double> &constraints;
-    MatrixFree<dim, double>          matrix_free;
+    MatrixFree<dim, double> matrix_free;
   };
 } // namespace membranes
 
