@@ -19,6 +19,19 @@ namespace membranes
   ActiveSetPrediction<dim>::reinit(const DiscreteProblem<dim> &problem)
   {
     predicted_action.reinit(problem);
+    const double        mu1 = data.mu[0], mu2 = data.mu[1], M = mu1 + mu2;
+    const double *const lifted_1  = problem.lifted_loads(0).begin();
+    const double *const lifted_2  = problem.lifted_loads(1).begin();
+    const auto         &vertices  = problem.vertices();
+    const auto         &positions = problem.local_positions();
+    w_load.resize(vertices.size());
+    sweep_step.resize(vertices.size());
+    for (unsigned int k = 0; k < vertices.size(); ++k)
+      {
+        const unsigned int p = positions[k];
+        w_load[k]            = (mu2 * lifted_1[p] - mu1 * lifted_2[p]) / M;
+        sweep_step[k] = 2 / (data.mu_bar * vertices[k].stiffness_row_l1_norm);
+      }
   }
 
 
@@ -41,33 +54,23 @@ namespace membranes
     // max(0, W_a − r_a / (μ̄ ‖A_a‖₁ / 2)), r_a = λ_a d_a the force of the
     // obstacle problem at a and ‖A_a‖₁ the l1 norm of its row of the
     // condensed Laplacian. With S fixed, r_a = μ̄ (A W)_a − b_a, b the
-    // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem): one product
-    // with A on the scalar W per sweep, on contiguous local arrays. The
+    // lifted loads of W, (μ2 L_1 − μ1 L_2)/M (DecoupledSystem; w_load and
+    // sweep_step from reinit()): one product with A on the scalar W per
+    // sweep, on contiguous local arrays. The
     // predicted iterate is U1 = (S + μ2 W)/M, U2 = (S − μ1 W)/M.
-    const double *const lifted_1 = problem.lifted_loads(0).begin();
-    const double *const lifted_2 = problem.lifted_loads(1).begin();
-    VectorType          w(solution.block(0));
+    VectorType w(solution.block(0));
     w -= solution.block(1);
     VectorType          stiffness_w(w);
     double *const       w_values = w.begin();
-    std::vector<double> load(vertices.size()),
-      inverse_diagonal(vertices.size());
-    for (unsigned int k = 0; k < vertices.size(); ++k)
-      {
-        const unsigned int p = positions[k];
-        load[k]              = (mu2 * lifted_1[p] - mu1 * lifted_2[p]) / M;
-        inverse_diagonal[k] =
-          2 / (data.mu_bar * vertices[k].stiffness_row_l1_norm);
-      }
-    const double *const product = stiffness_w.begin();
+    const double *const product  = stiffness_w.begin();
     for (unsigned int sweep = 0; sweep < n_prediction_sweeps; ++sweep)
       {
         problem.laplace_matrix().vmult(stiffness_w, w);
         for (unsigned int k = 0; k < vertices.size(); ++k)
           {
             const unsigned int p = positions[k];
-            const double       r = data.mu_bar * product[p] - load[k];
-            w_values[p] = std::max(0., w_values[p] - r * inverse_diagonal[k]);
+            const double       r = data.mu_bar * product[p] - w_load[k];
+            w_values[p] = std::max(0., w_values[p] - r * sweep_step[k]);
           }
       }
     BlockVectorType iterate;

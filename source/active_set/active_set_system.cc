@@ -27,12 +27,10 @@ namespace membranes
 
 
   template <int dim>
-  void
-  ActiveSetSystem<dim>::for_each_row(
-    const DiscreteProblem<dim>                   &problem,
-    const TrilinosWrappers::SparseMatrix         &matrix,
-    const IndexSet                               &active_set,
-    const std::function<void(const MatrixRow &)> &row_function)
+  std::vector<char>
+  ActiveSetSystem<dim>::active_columns(
+    const TrilinosWrappers::SparseMatrix &matrix,
+    const IndexSet                       &active_set)
   {
     // The status of the vertex of every column: the owners' flags imported
     // by the matrix's own importer, for the columns of a row can reach
@@ -53,29 +51,10 @@ namespace membranes
       column_flags.Import(owned_flags, *epetra_matrix.Importer(), Insert);
     else
       column_flags = owned_flags;
-    std::vector<char> active_columns(columns.NumMyElements());
+    std::vector<char> status(columns.NumMyElements());
     for (int c = 0; c < columns.NumMyElements(); ++c)
-      active_columns[c] = (column_flags[c] > 0);
-
-    // The rows and the vertices of V_h are both sorted by the DoF.
-    const auto &vertices = problem.vertices();
-    auto        vertex   = vertices.begin();
-    MatrixRow   row;
-    row.column_map     = &columns;
-    row.active_columns = &active_columns;
-    for (int r = 0; r < epetra_matrix.NumMyRows(); ++r)
-      {
-        row.dof = TrilinosWrappers::global_index(epetra_matrix.RowMap(), r);
-        while (vertex != vertices.end() && vertex->dof < row.dof)
-          ++vertex;
-        row.active             = active_columns[columns.LID(
-          static_cast<TrilinosWrappers::types::int_type>(row.dof))];
-        row.stiffness_diagonal = row.active ? vertex->stiffness_diagonal : 0;
-        int *indices;
-        epetra_matrix.ExtractMyRowView(r, row.n_entries, row.values, indices);
-        row.columns = indices;
-        row_function(row);
-      }
+      status[c] = (column_flags[c] > 0);
+    return status;
   }
 
 

@@ -105,11 +105,8 @@ namespace membranes
     system_matrix.reinit(owned, owned, dsp, this->mpi_communicator);
     system_rhs.reinit(owned, this->mpi_communicator);
     system_solution.reinit(owned, this->mpi_communicator);
-    // The tension μ_i of the membrane of each locally owned unknown: those
-    // of u1, then those of u2.
-    tension.reinit(owned, this->mpi_communicator);
-    std::fill_n(tension.begin(), n_owned, this->data.mu[0]);
-    std::fill_n(tension.begin() + n_owned, n_owned, this->data.mu[1]);
+    scaling.get_vector().reinit(owned, this->mpi_communicator);
+    inverse_scaling.get_vector().reinit(owned, this->mpi_communicator);
   }
 
 
@@ -216,21 +213,28 @@ namespace membranes
 
 
   template <int dim>
-  typename CoupledSystem<dim>::VectorType
-  CoupledSystem<dim>::tension_scaling(const DiscreteProblem<dim> &problem,
-                                      const IndexSet &active_set) const
+  void
+  CoupledSystem<dim>::set_scaling(const DiscreteProblem<dim> &problem,
+                                  const IndexSet             &active_set)
   {
-    const double M       = this->data.mu[0] + this->data.mu[1];
-    VectorType   scaling = tension;
-    for (const auto dof : problem.locally_relevant_vertices())
-      if (active_set.is_element(dof) &&
-          problem.locally_owned_dofs().is_element(dof))
+    // m_j = μ_i at the unknowns of membrane i (the owned entries of u1, then
+    // those of u2), μ1 + μ2 at both unknowns of an active vertex.
+    const double       M       = this->data.mu[0] + this->data.mu[1];
+    VectorType        &d       = scaling.get_vector();
+    const unsigned int n_owned = problem.locally_owned_dofs().n_elements();
+    for (unsigned int i = 0; i < 2; ++i)
+      std::fill_n(d.begin() + i * n_owned,
+                  n_owned,
+                  1 / std::sqrt(this->data.mu[i]));
+    for (const auto dof : active_set)
+      if (problem.locally_owned_dofs().is_element(dof))
         for (unsigned int i = 0; i < 2; ++i)
-          scaling[block_indices.local_to_global(i, dof)] = M;
-    for (auto &entry : scaling)
-      entry = 1 / std::sqrt(entry);
-    scaling.compress(VectorOperation::insert);
-    return scaling;
+          d[block_indices.local_to_global(i, dof)] = 1 / std::sqrt(M);
+    d.compress(VectorOperation::insert);
+    std::transform(d.begin(),
+                   d.end(),
+                   inverse_scaling.get_vector().begin(),
+                   [](const double entry) { return 1 / entry; });
   }
 
 
@@ -252,7 +256,7 @@ namespace membranes
     constraints.merge(mesh_constraints);
     constraints.close();
     assemble_system(problem, active_set);
-    scaling = tension_scaling(problem, active_set);
+    set_scaling(problem, active_set);
   }
 
 
@@ -278,30 +282,26 @@ namespace membranes
         // (μ1 + μ2)) (sums over active vertices only r_S), so one bound on
         // it bounds r_S and r_W each on its own scale. D⁻¹ P D⁻¹, P the AMG
         // hierarchy of K built on every iteration, preconditions it.
-        VectorType inverse_scaling(scaling);
-        for (auto &entry : inverse_scaling)
-          entry = 1 / entry;
-        VectorType rhs = system_rhs;
-        rhs.scale(scaling);
-        x.scale(inverse_scaling);
+        // The right-hand side is scaled in place: it is assembled anew for
+        // the next iteration.
+        system_rhs.scale(scaling.get_vector());
+        x.scale(inverse_scaling.get_vector());
         this->linear_solver.initialize_preconditioner(system_matrix);
         const double tolerance =
           std::min(tolerances.contact / std::sqrt(this->data.mu_bar),
                    tolerances.sum /
                      std::sqrt(this->data.mu[0] + this->data.mu[1]));
-        const DiagonalMatrix<VectorType> scale(scaling),
-          inverse_scale(inverse_scaling);
         const auto K = linear_operator<VectorType>(system_matrix);
-        const auto D = linear_operator<VectorType>(system_matrix, scale);
+        const auto D = linear_operator<VectorType>(system_matrix, scaling);
         const auto D_inverse =
-          linear_operator<VectorType>(system_matrix, inverse_scale);
+          linear_operator<VectorType>(system_matrix, inverse_scaling);
         const auto amg =
           linear_operator<VectorType>(system_matrix,
                                       this->linear_solver.preconditioner());
         statistics.linear_iterations += this->linear_solver.solve_cg(
-          D * K * D, D_inverse * amg * D_inverse, x, rhs, tolerance);
+          D * K * D, D_inverse * amg * D_inverse, x, system_rhs, tolerance);
         this->linear_solver.clear();
-        x.scale(scaling);
+        x.scale(scaling.get_vector());
       }
     constraints.distribute(x);
     copy_from_system(solution);
@@ -317,8 +317,8 @@ namespace membranes
     system_matrix.clear();
     system_rhs.clear();
     system_solution.clear();
-    tension.clear();
-    scaling.clear();
+    scaling.get_vector().clear();
+    inverse_scaling.get_vector().clear();
     constraints.clear();
     mesh_constraints.clear();
   }

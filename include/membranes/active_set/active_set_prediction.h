@@ -22,8 +22,8 @@ namespace membranes
    * discrete contact zone of a finer mesh reaches several layers of
    * vertices beyond the one interpolated from the coarser mesh: with
    * u1 − u2 ~ dist³, the O(h²) errors of the coarse solution move its edge
-   * by O(h^{2/3}), i.e. by O(h^{−1/3}) layers (benchmarks/README.md, "The
-   * prediction of the active set, before and after", measures it). The
+   * by O(h^{2/3}), i.e. by O(h^{−1/3}) layers (benchmarks/choices.md, "The
+   * prediction of the active set", measures it). The
    * plain update of ActiveSet then overshoots: the first solve penetrates
    * over a band wider than the missing one, all of it is activated, and the
    * surplus is released one layer per iteration, because only its outer
@@ -45,8 +45,8 @@ namespace membranes
    * energy norm of the error, on any mesh; plain Jacobi has no such
    * guarantee where A has positive entries off the diagonal, and l1-Jacobi
    * (the divisor ‖A_a‖₁) takes half the step of plain Jacobi on the rows
-   * that sum to zero (benchmarks/README.md, "The prediction of the active
-   * set, before and after", compares the three). Each sweep carries the contact
+   * that sum to zero (benchmarks/choices.md, "The prediction of the active
+   * set", compares the three). Each sweep carries the contact
    * information one layer further: penetrated vertices are clamped and lift
    * their neighbours, active vertices pulled apart are released with the ones
    * behind them. Where the predicted test is within the band of indifference of
@@ -72,7 +72,11 @@ namespace membranes
     ActiveSetPrediction(const Parameters::Solver &parameters,
                         const ProblemData<dim>   &data);
 
-    /** Work on the mesh of @p problem. */
+    /**
+     * Work on the mesh of @p problem: the lifted loads b of W and the steps
+     * 2 / (μ̄ ‖A_a‖₁) of the sweeps, which are the same on every iteration
+     * of the mesh.
+     */
     void
     reinit(const DiscreteProblem<dim> &problem);
 
@@ -99,8 +103,8 @@ namespace membranes
     /**
      * Sweeps of projected Jacobi: more layers than the free boundary moves
      * between two nested meshes, which grows like O(h^{−1/3}) at a
-     * degenerate free boundary (benchmarks/README.md, "The prediction of
-     * the active set, before and after").
+     * degenerate free boundary (benchmarks/choices.md, "The prediction of
+     * the active set").
      */
     static constexpr unsigned int n_prediction_sweeps = 40;
 
@@ -108,6 +112,12 @@ namespace membranes
     const ProblemData<dim>   &data;
     /** λ_a of the predicted iterate (not that of the iterate itself). */
     DiscreteAction<dim> predicted_action;
+    /**
+     * For each locally owned vertex of V_h (in the order of
+     * DiscreteProblem::vertices()): b_a = (μ2 L_1 − μ1 L_2)_a / M, the
+     * lifted load of W, and 2 / (μ̄ ‖A_a‖₁), the step of its sweep.
+     */
+    std::vector<double> w_load, sweep_step;
   };
 } // namespace membranes
 

@@ -8,7 +8,6 @@
 #include <deal.II/lac/trilinos_parallel_block_vector.h>
 #include <deal.II/lac/trilinos_sparse_matrix.h>
 #include <deal.II/lac/trilinos_vector.h>
-#include <functional>
 #include <membranes/active_set/active_set_solver.h>
 #include <membranes/active_set/linear_solver.h>
 #include <membranes/mesh/discrete_problem.h>
@@ -16,6 +15,7 @@
 #include <membranes/scene/parameters.h>
 #include <membranes/scene/problem_data.h>
 #include <string>
+#include <vector>
 
 namespace membranes
 {
@@ -60,9 +60,10 @@ namespace membranes
 
     /**
      * Impose @p active_set (DoFs of the active locally relevant vertices,
-     * ActiveSet::locally_relevant(), so that every process knows the
-     * constraints of the cells it assembles) on the linear problem on the
-     * mesh of @p problem: here, not in solve().
+     * ActiveSet::locally_relevant()) on the linear problem on the mesh of
+     * @p problem: here, not in solve(). The lines u1(a) = u2(a) of the
+     * active ghost vertices are needed where a hanging node of an owned
+     * cell hangs on one: its line resolves through the contact line.
      * CoupledSystem merges its contact lines u1(a) = u2(a) into
      * AffineConstraints and assembles the condensed system; DecoupledSystem
      * imposes W_a = 0 as the projection Π of the operator of W, and
@@ -138,13 +139,15 @@ namespace membranes
      * the Laplacian of @p problem, or the Laplacian itself) with the
      * locally relevant active vertices @p active_set: one pass over the
      * locally stored entries by Epetra's row views, which point into the
-     * values of the matrix.
+     * values of the matrix. A template, so that the compiler sees the
+     * function of a row inside the loop over the rows.
      */
+    template <typename RowFunction>
     static void
-    for_each_row(const DiscreteProblem<dim>                   &problem,
-                 const TrilinosWrappers::SparseMatrix         &matrix,
-                 const IndexSet                               &active_set,
-                 const std::function<void(const MatrixRow &)> &row_function);
+    for_each_row(const DiscreteProblem<dim>           &problem,
+                 const TrilinosWrappers::SparseMatrix &matrix,
+                 const IndexSet                       &active_set,
+                 const RowFunction                    &row_function);
 
     ActiveSetSystem(const std::string        &method,
                     const Parameters::Solver &parameters,
@@ -156,8 +159,51 @@ namespace membranes
     LinearSolver            linear_solver;
 
   private:
+    /**
+     * Whether each column of @p matrix (in Epetra's local numbering of its
+     * column map) is an active vertex of @p active_set.
+     */
+    static std::vector<char>
+    active_columns(const TrilinosWrappers::SparseMatrix &matrix,
+                   const IndexSet                       &active_set);
+
     const std::string method;
   };
+
+
+
+  template <int dim>
+  template <typename RowFunction>
+  void
+  ActiveSetSystem<dim>::for_each_row(
+    const DiscreteProblem<dim>           &problem,
+    const TrilinosWrappers::SparseMatrix &matrix,
+    const IndexSet                       &active_set,
+    const RowFunction                    &row_function)
+  {
+    const Epetra_CrsMatrix &epetra_matrix = matrix.trilinos_matrix();
+    const std::vector<char> column_status = active_columns(matrix, active_set);
+
+    // The rows and the vertices of V_h are both sorted by the DoF.
+    const auto &vertices = problem.vertices();
+    auto        vertex   = vertices.begin();
+    MatrixRow   row;
+    row.column_map     = &epetra_matrix.ColMap();
+    row.active_columns = &column_status;
+    for (int r = 0; r < epetra_matrix.NumMyRows(); ++r)
+      {
+        row.dof = TrilinosWrappers::global_index(epetra_matrix.RowMap(), r);
+        while (vertex != vertices.end() && vertex->dof < row.dof)
+          ++vertex;
+        row.active             = column_status[epetra_matrix.ColMap().LID(
+          static_cast<TrilinosWrappers::types::int_type>(row.dof))];
+        row.stiffness_diagonal = row.active ? vertex->stiffness_diagonal : 0;
+        int *indices;
+        epetra_matrix.ExtractMyRowView(r, row.n_entries, row.values, indices);
+        row.columns = indices;
+        row_function(row);
+      }
+  }
 } // namespace membranes
 
 #endif

@@ -4,6 +4,7 @@
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/block_indices.h>
+#include <deal.II/lac/diagonal_matrix.h>
 #include <membranes/active_set/active_set_system.h>
 
 namespace membranes
@@ -30,7 +31,8 @@ namespace membranes
    * solution of each iteration satisfies Prop. 12 (λ from either membrane) by
    * construction; on inactive vertices both equations hold, i.e. λ_a = 0. This
    * is the reference method: clear, and an assembly of the whole system per
-   * iteration (its cost is in benchmarks/README.md).
+   * iteration (its cost is in benchmarks/choices.md, "The matrices of an active
+   * set from the mesh's A").
    *
    * The rows of the two membranes are forces of tensions μ1 and μ2, and of
    * μ1 + μ2 where the contact constraint adds them: for tension ratios far
@@ -109,12 +111,13 @@ namespace membranes
                     const IndexSet             &active_set);
 
     /**
-     * The diagonal m_j^{-1/2} of the scaling of the system of @p active_set
-     * on the mesh of @p problem (locally owned entries; see solve()).
+     * The diagonal D = diag(m_j^{-1/2}) of the scaling of the system of
+     * @p active_set on the mesh of @p problem, and its inverse, in place
+     * (locally owned entries; see solve()).
      */
-    VectorType
-    tension_scaling(const DiscreteProblem<dim> &problem,
-                    const IndexSet             &active_set) const;
+    void
+    set_scaling(const DiscreteProblem<dim> &problem,
+                const IndexSet             &active_set);
     /** The numbering of the unknowns: block 0 (u1), then block 1 (u2). */
     BlockIndices block_indices;
 
@@ -130,10 +133,11 @@ namespace membranes
      * solution one after the other in its local storage.
      */
     VectorType system_solution;
-    /** The scaling of the system (see solve()) for the current active set. */
-    VectorType scaling;
-    /** μ_i at each locally owned unknown of membrane i. */
-    VectorType tension;
+    /**
+     * The scaling D of the system (see solve()) for the current active set,
+     * and D⁻¹: allocated once per mesh, set on every iteration.
+     */
+    DiagonalMatrix<VectorType> scaling, inverse_scaling;
   };
 } // namespace membranes
 
