@@ -1,6 +1,6 @@
 /**
  * UMFPACK against MUMPS on the direct solves that `Linear solver = auto`
- * makes on one process (benchmarks/README.md, "The direct solver on one
+ * makes on one process (benchmarks/choices.md, "The direct solver on one
  * process"):
  *
  *   build/direct_solvers [repetitions [largest unknowns]]

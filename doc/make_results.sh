@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every table and figure of README.md, doc/tutorial.md, doc/advanced.md and
-# benchmarks/README.md, made anew from the built program.
+# benchmarks/*.md, made anew from the built program.
 #
 #   doc/make_results.sh [path/to/membranes] [work-dir]
 #
@@ -14,14 +14,14 @@
 # of the documents (doc/results.py splice), and the figures to doc/images/.
 # SECTIONS in the environment chooses what to make (default: all of
 # "benchmarks readme tutorial"); "benchmarks" runs every script of
-# benchmarks/ (about half an hour on two cores, up to 9 GB of memory for
+# benchmarks/ (about an hour on two cores, up to 9 GB of memory for
 # mpi_scaling.sh); the section tutorial summarizes some of their runs and
 # the run of the default scene of section readme (whose figure it shows
 # too), so it comes last. The section tutorial writes doc/tutorial.md,
 # doc/advanced.md (the identities of the flux reconstruction) and the
-# comparison of exact and balanced stopping in benchmarks/README.md. BLOCKS
+# comparison of exact and balanced stopping in benchmarks/solvers.md. BLOCKS
 # in the environment limits the section benchmarks to the blocks of
-# benchmarks/README.md it names (e.g. BLOCKS="solver-cost flux-estimator");
+# benchmarks/*.md it names (e.g. BLOCKS="solver-cost flux-estimator");
 # the others are left as they are. The peer benchmark needs python3-dolfinx; without it its table is
 # left as it is and the script says so. The figures need python3-matplotlib.
 #
@@ -70,7 +70,8 @@ run() {
 # benchmark BLOCK DIR SCRIPT [ENV=VALUE...]: one script of benchmarks/ into
 # <work-dir>/DIR, whose missed targets (exit status 1) do not stop this
 # script, and its table.md (of adaptivity.sh only the comparisons at equal
-# error) under the machine's state as block BLOCK of benchmarks/README.md.
+# error) under the machine's state as block BLOCK of its document
+# (benchmark_document).
 benchmark() {
   local block=$1 out=$work/$2 script=$3 status=0 conditions
   shift 3
@@ -92,7 +93,20 @@ benchmark() {
     else
       cat "$out/table.md"
     fi
-  } | block benchmarks/README.md "$block"
+  } | block "$(benchmark_document "$block")" "$block"
+}
+
+# benchmark_document BLOCK: the file of benchmarks/ that holds the entry of
+# the benchmark whose table is block BLOCK.
+benchmark_document() {
+  case $1 in
+  solver-cost | solver-cost-balanced | balanced | stability) echo benchmarks/solvers.md ;;
+  adaptivity | flux-estimator | flux-effectivity | error-quadrature | error-columns)
+    echo benchmarks/estimators.md ;;
+  mpi-scaling) echo benchmarks/parallel.md ;;
+  peer-snesvi) echo benchmarks/costs.md ;;
+  *) echo benchmarks/README.md ;;
+  esac
 }
 
 # chosen BLOCK: whether BLOCKS (all blocks if unset) names BLOCK.
@@ -110,7 +124,7 @@ membranes_run() {
 }
 
 # block DOCUMENT NAME < TABLE: the table between the markers NAME of
-# DOCUMENT. In benchmarks/README.md below the list of commands run since the
+# DOCUMENT. In the documents of benchmarks/ below the list of commands run since the
 # last block ("Made by"); README.md and the documents of doc/ teach and hold
 # the table alone, their commands are collected in readme_commands and
 # doc_commands for the blocks readme-runs and tutorial-runs of
@@ -176,9 +190,27 @@ for section in $sections; do
       figure "$work/adaptivity/lshape-convergence.png" lshape-convergence.png
       figure "$work/adaptivity/slit-convergence.png" slit-convergence.png
     fi
-    for script in flux_estimator flux_effectivity stability mpi_scaling; do
+    for script in flux_estimator flux_effectivity stability mpi_scaling \
+      error_quadrature; do
       benchmark "${script//_/-}" "$script" "$script.sh"
     done
+    # error_columns.sh prints its table (after its progress lines) instead
+    # of writing table.md: the default size, then 2 101 250 DoFs once.
+    if chosen error-columns; then
+      commands=()
+      conditions=$(machine)
+      run benchmarks/error_columns.sh "$membranes" "$work/error_columns" \
+        >"$work/error_columns.log" 2>&1
+      run env CYCLES=9 ROUNDS=1 benchmarks/error_columns.sh "$membranes" \
+        "$work/error_columns-9" >"$work/error_columns-9.log" 2>&1
+      {
+        echo "$conditions"
+        echo
+        grep '^|' "$work/error_columns.log"
+        echo
+        grep '^|' "$work/error_columns-9.log"
+      } | block "$(benchmark_document error-columns)" error-columns
+    fi
     if chosen peer-snesvi; then
       if $python -c "import dolfinx" 2>/dev/null; then
         benchmark peer-snesvi peer_snesvi peer_snesvi.sh
@@ -270,7 +302,7 @@ for section in $sections; do
     run $python doc/results.py balanced "${arguments[@]}" \
       >"$work/blocks/balanced.table"
     { machine; echo; cat "$work/blocks/balanced.table"; } |
-      block benchmarks/README.md balanced
+      block "$(benchmark_document balanced)" balanced
 
     # From the runs of the benchmarks (section benchmarks).
     commands=()

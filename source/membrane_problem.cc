@@ -275,7 +275,7 @@ namespace membranes
                  exact,
                  mpi_communicator);
     // λ in H^{-1}(ω) through its Riesz representative of degree 2
-    // (benchmarks/README.md, "The H^-1 norm of the action").
+    // (benchmarks/estimators.md, "The H^-1 norm of the action").
     if (exact.computes("err_lambda_Hm1"))
       errors.lambda_Hm1 = NegativeNorm<dim>(discretization)
                             .lambda_error(dof_handler,

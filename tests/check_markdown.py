@@ -69,7 +69,12 @@ def documents():
     """The documents whose math must balance, relative to ROOT."""
     names = sorted(os.path.relpath(p, ROOT)
                    for p in glob.glob(os.path.join(ROOT, "doc", "*.md")))
-    return names + [n for n in ("README.md", "benchmarks/README.md")
+    return names + [n for n in ("README.md", "benchmarks/README.md",
+                                "benchmarks/choices.md", "benchmarks/costs.md",
+                                "benchmarks/estimators.md",
+                                "benchmarks/floors.md",
+                                "benchmarks/parallel.md",
+                                "benchmarks/solvers.md")
                     if os.path.exists(os.path.join(ROOT, n))]
 
 

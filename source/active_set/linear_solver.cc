@@ -47,7 +47,7 @@ namespace membranes
   LinearSolver::initialize_preconditioner(const MatrixType &matrix)
   {
     // Smoothed aggregation (ML's default): lower-memory settings slow CG down
-    // (benchmarks/README.md, "The settings of ML and the peak memory").
+    // (benchmarks/choices.md, "The settings of ML and the peak memory").
     TrilinosWrappers::PreconditionAMG::AdditionalData amg_data;
     amg_data.elliptic        = true;
     amg_data.constant_modes  = constant_modes;
@@ -111,7 +111,7 @@ namespace membranes
       }
     // UMFPACK factorizes deal.II's SparseMatrix: the rows of the Epetra
     // matrix copied into one, not by SparseMatrix::copy_from()
-    // (benchmarks/README.md, "The direct solver on one process").
+    // (benchmarks/choices.md, "The direct solver on one process").
     const Epetra_CrsMatrix &epetra         = matrix.trilinos_matrix();
     const auto              for_each_entry = [&epetra](const auto &f) {
       for (int row = 0; row < epetra.NumMyRows(); ++row)

@@ -204,7 +204,8 @@ namespace membranes
     // MeshWorker::mesh_loop with assemble_own_interior_faces_once does.
     // On P1 the jumps of the constant gradients of the cells, computed once
     // per cell by p1_gradients(), need no FEInterfaceValues, which is
-    // slower there (benchmarks/README.md, "Choices measured in the code");
+    // slower there (benchmarks/choices.md, "The face terms of the residual
+    // estimator");
     // and on triangles with hanging nodes deal.II 9.4 stops in
     // QProjector::DataSetDescriptor::subface, which knows quadrilaterals
     // only.) Ghost cells take

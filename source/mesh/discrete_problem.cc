@@ -193,7 +193,7 @@ namespace membranes
     const VectorType                &stiffness_diagonal)
   {
     // 1/‖A_a‖₁ of the locally owned rows of A, by Epetra's own inverse row
-    // sums of absolute values (benchmarks/README.md, "The matrices of an
+    // sums of absolute values (benchmarks/choices.md, "The matrices of an
     // active set from the mesh's A", says why not deal.II's row iterator).
     VectorType inverse_row_l1_norm(owned_dofs, mpi_communicator);
     AssertThrow(matrix.trilinos_matrix().InvRowSums(

@@ -27,7 +27,7 @@ namespace membranes
    *   multigrid, with the constant near-null-space modes reinit() is given:
    *   one per block of the coupled system of (u1, u2), one for s or w.
    * - `auto`: direct up to direct_solver_dof_limit unknowns on one process,
-   *   cg-amg otherwise, on both cell types (benchmarks/README.md,
+   *   cg-amg otherwise, on both cell types (benchmarks/floors.md,
    *   "`gmg_floor.sh`", for why geometric multigrid is not offered).
    *
    * CG stops at the residual norm it is given, and starts from the vector
@@ -51,14 +51,14 @@ namespace membranes
     /**
      * The Amesos package of the direct solver on several processes: MUMPS,
      * a multifrontal LU factorization with pivoting that runs on all
-     * processes of the matrix (benchmarks/README.md, "The direct solver on
+     * processes of the matrix (benchmarks/choices.md, "The direct solver on
      * one process", for UMFPACK on one).
      */
     static constexpr const char *direct_solver_package = "Amesos_Mumps";
 
     /**
      * Largest problem that `auto` hands to the direct solver
-     * (benchmarks/README.md, "`solver_crossover.py`").
+     * (benchmarks/solvers.md, "`solver_crossover.py`").
      */
     static constexpr types::global_dof_index direct_solver_dof_limit = 1000;
 

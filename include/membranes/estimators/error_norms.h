@@ -61,10 +61,10 @@ namespace membranes
    *   the vertices, alone (ProblemData::exact_action_list(): u may be
    *   singular there).
    *
-   * The quadrature error of these rules: benchmarks/README.md,
+   * The quadrature error of these rules: benchmarks/estimators.md,
    * "`error_quadrature.sh`". VectorTools::integrate_difference() takes the
    * quadrature as an argument too, but makes one pass and one evaluation
-   * of the exact solution per norm and membrane (benchmarks/README.md,
+   * of the exact solution per norm and membrane (benchmarks/choices.md,
    * "Error norms in one pass").
    */
 

@@ -63,15 +63,15 @@ namespace membranes
    * same, to the last bit, for any number of threads.
    *
    * WorkStream hands the items to the threads in chunks of `chunk_size`
-   * items instead of its default of 8 (benchmarks/README.md, "The chunks of
-   * the cell loops, before and after").
+   * items instead of its default of 8 (benchmarks/choices.md, "The chunks of
+   * the cell loops").
    *
    * An exception thrown by the worker (an expression of the scene that is
    * not finite at a point) would end the program in WorkStream, which
    * aborts on exceptions of its threads: the first one is kept, the
    * remaining items are skipped, and it is thrown again here, on the
    * calling thread, as from a loop without threads (hence not
-   * MeshWorker::mesh_loop(): benchmarks/README.md, "Cell loops that pass
+   * MeshWorker::mesh_loop(): benchmarks/choices.md, "Cell loops that pass
    * exceptions on").
    */
   template <typename Copy,

@@ -48,7 +48,7 @@ namespace membranes
    *   a cell is refined if η_K² ≥ (1 − 10⁻⁶) t, t the smallest indicator
    *   of the share, and coarsened if η_K² ≤ (1 + 10⁻⁶) b. Indicators that
    *   agree to a relative 10⁻⁶, far above their differences between
-   *   partitions (benchmarks/README.md, `process_count.py`), are so
+   *   partitions (benchmarks/parallel.md, `process_count.py`), are so
    *   marked together or not at all. A cell whose indicator is not tied
    *   to t but lies within 10⁻⁶ below it is refined too, which changes
    *   the marked share by a few cells at most.

@@ -95,7 +95,7 @@ namespace membranes
      * record of all pieces with @p write_record (given their file names);
      * then the .pvd file over the cycles in @p written. (Not
      * DataOut::write_vtu_with_pvtu_record(), which opens the files itself:
-     * benchmarks/README.md, "Atomic output files".)
+     * benchmarks/choices.md, "Atomic output files".)
      */
     void
     write_cycle(

@@ -66,8 +66,8 @@ namespace membranes
      *
      * With @p vector_math, the loop over the points may evaluate several
      * points at once, with the vector forms of sin, cos, exp, log and pow
-     * that glibc provides (libmvec, on x86-64; benchmarks/README.md, "Vector
-     * math in the error norms, before and after"), but these
+     * that glibc provides (libmvec, on x86-64; benchmarks/choices.md, "Vector
+     * math in the error norms"), but these
      * functions are accurate to a few units in the last place, where the
      * scalar ones, which the parser calls, are correctly rounded in
      * practice. So only for values that decide nothing in the discrete
