@@ -67,6 +67,24 @@ set_tests_properties(markdown_escaped_math PROPERTIES LABELS quick
   PASS_REGULAR_EXPRESSION
   "md:1: '\\\\{' in inline math.*md:1: '\\\\}' in inline math.*md:1: '\\\\,' in inline math.*md:4: '\\\\\\\\' in display math")
 
+# One meaning per symbol in doc/tutorial.md and doc/advanced.md
+# (tests/check_symbols.py): no symbol in two rows of their symbol tables,
+# none introduced again in the text ("with $X$ the ...", "$X$ denotes ...")
+# with a meaning that shares no word with the table's. Catches: a symbol
+# given a second meaning, or listed again by advanced.md.
+add_test(NAME symbols
+  COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/tests/check_symbols.py
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(symbols PROPERTIES LABELS quick)
+# The same check on copies of the documents with a duplicate row and a
+# second meaning planted: it must report both. Catches: a check that lets
+# them pass.
+add_test(NAME symbols_planted
+  COMMAND ${Python3_EXECUTABLE} ${CMAKE_SOURCE_DIR}/tests/check_symbols.py
+          --planted
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(symbols_planted PROPERTIES LABELS quick)
+
 # The size limits of the repository (tests/check_code_size.py): no file
 # over 800 lines, no function of C++ or Python over 100 lines; it also
 # prints the size of the library. Catches: a file or a function that grew
