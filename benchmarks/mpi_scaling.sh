@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Strong scaling from one to two MPI processes, Q1 beside P1.
+# Strong scaling from one to two MPI processes, Q1 beside P1 (and, with
+# PROCESSES="1 2 3", memory on three and the memory model).
 #
 #   benchmarks/mpi_scaling.sh [path/to/membranes] [output-dir]
 #
@@ -22,14 +23,31 @@
 # wall time per phase on one and two processes and the speed-up, the peak
 # memory per process, the memory that the second process adds per cell,
 # and the check that both runs computed the same thing (DoFs, active
-# vertices, energy error). The exit status is that script's.
+# vertices, energy error). The exit status is 1 if that script (or
+# memory_model.py, below) fails or finds the runs in disagreement, else 0.
 # CYCLES=n in the environment shortens the run for a quick try.
+#
+# PROCESSES="1 2 3" in the environment runs each scene on these process
+# counts instead of "1 2" (the table above needs 1 and 2 among them). A count
+# above the cores of the machine is started with --oversubscribe: on two
+# cores, three processes share them, which makes them slow but leaves
+# their memory as it is. With any count other than 1 and 2, the memory
+# model of benchmarks/memory_model.py (bytes per process = a + b N/P + c N,
+# fitted to every cycle of every run, and the largest N that P processes of
+# M bytes each reach) follows the table and is kept in
+# <output-dir>/memory-model.md. CELL_TYPES=quadrilateral (or triangle) runs
+# one cell type alone, e.g. one cycle more (CYCLES=10, 8 396 802 DoFs) for
+# Q1, whose three processes hold about 8 GB together where P1's would need
+# twice that.
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 membranes=${1:-$root/build/membranes}
 out=${2:-/tmp/membranes-mpi-scaling}
 cycles=${CYCLES:-9}
+read -r -a process_counts <<< "${PROCESSES:-1 2}"
+read -r -a cell_types <<< "${CELL_TYPES:-quadrilateral triangle}"
+cores=$(nproc)
 
 if [[ ! -x $membranes ]]; then
   echo "mpi_scaling.sh: error: '$membranes' is not an executable" >&2
@@ -39,11 +57,17 @@ fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
 reports=()
-for cell_type in quadrilateral triangle; do
+model=()
+for cell_type in "${cell_types[@]}"; do
   scene=$root/parameters/case-m-$cell_type.prm
-  for processes in 1 2; do
+  for processes in "${process_counts[@]}"; do
     dir=$out/$cell_type/np$processes
-    command=(mpiexec -n "$processes" --bind-to none "$membranes"
+    oversubscribe=()
+    if (( processes > cores )); then
+      oversubscribe=(--oversubscribe)
+    fi
+    command=(mpiexec -n "$processes" "${oversubscribe[@]}" --bind-to none
+             "$membranes"
              --set "Refinement/Cycles=$cycles"
              --set "Solver/Linear solver=cg-amg"
              --set "Output/Write vtu=false"
@@ -53,11 +77,27 @@ for cell_type in quadrilateral triangle; do
     rm -f "$dir/report.csv"
     echo "== $cell_type, $processes process(es): ${command[*]}"
     "${command[@]}" 2>&1 | tee "$out/$cell_type-np$processes.log"
+    model+=("$cell_type=$dir/report.csv")
   done
   reports+=("$cell_type" "$out/$cell_type/np1/report.csv"
             "$out/$cell_type/np2/report.csv")
 done
 
-/usr/bin/env python3 "$root/benchmarks/mpi_scaling_table.py" "${reports[@]}" |
-  tee "$out/table.md"
-exit "${PIPESTATUS[0]}"
+status=0
+if [[ " ${process_counts[*]} " == *" 1 "* &&
+      " ${process_counts[*]} " == *" 2 "* ]]; then
+  if ! /usr/bin/env python3 "$root/benchmarks/mpi_scaling_table.py" \
+         "${reports[@]}" | tee "$out/table.md"; then
+    status=1
+  fi
+else
+  echo "mpi_scaling.sh: no table (it compares 1 and 2 processes)"
+fi
+if [[ " ${process_counts[*]} " != " 1 2 " ]]; then
+  echo
+  if ! /usr/bin/env python3 "$root/benchmarks/memory_model.py" \
+         "${model[@]}" | tee "$out/memory-model.md"; then
+    status=1
+  fi
+fi
+exit "$status"
