@@ -7,7 +7,7 @@
  * by P1/Q1 finite elements, a primal-dual active set method, and the
  * discrete action λ_h on the dual mesh.
  *
- *   membranes [--set "Subsection/Entry=value"]... scene.prm
+ *   membranes [--set "Subsection/Entry=value"]... [--resume] scene.prm
  *   membranes --print-parameters
  */
 
@@ -42,6 +42,8 @@ namespace
     "                             documentation, in parameter file syntax\n"
     "  -s, --set 'Sub/Entry=val'  override one entry after reading the scene,\n"
     "                             e.g. --set 'Refinement/Cycles=4'\n"
+    "  -r, --resume               continue the study of the output directory\n"
+    "                             from its checkpoint (--set 'Output/Resume=true')\n"
     "\n"
     "Run on N processes with 'mpirun -np N membranes scene.prm'.\n"
     "\n"
@@ -108,7 +110,9 @@ namespace
           (arg == "-p" || arg == "--print-parameters");
         if (arguments.help || arguments.print_parameters)
           return arguments;
-        if (arg == "-s" || arg == "--set")
+        if (arg == "-r" || arg == "--resume")
+          arguments.assignments.push_back("Output/Resume=true");
+        else if (arg == "-s" || arg == "--set")
           {
             if (i + 1 == argc)
               throw membranes::Parameters::InputError(arg +
@@ -212,6 +216,11 @@ main(int argc, char **argv)
           return 0;
         }
       const Parameters::All parameters = read_parameters(prm, arguments);
+      // The record of the run describes the study: run again, it makes the
+      // whole of it, also when this run resumes it.
+      prm.enter_subsection("Output");
+      prm.set("Resume", false);
+      prm.leave_subsection();
 
       MembraneProblem<2> problem(parameters,
                                  {Parameters::parameter_file(prm),

@@ -47,6 +47,11 @@ namespace membranes
     , output_directory(parameters.output.directory,
                        provenance,
                        mpi_communicator)
+    , checkpoint(
+        parameters.output.checkpoint_every > 0 || parameters.output.resume ?
+          std::make_unique<Checkpoint<dim>>(parameters.output.directory,
+                                            mpi_communicator) :
+          nullptr)
   {}
 
 
@@ -516,6 +521,8 @@ namespace membranes
                      mpi_communicator);
       }
     triangulation->prepare_coarsening_and_refinement();
+    if (checkpoint)
+      checkpoint->record_refinement(*triangulation);
 
     if (distributed_triangulation)
       {
@@ -665,6 +672,73 @@ namespace membranes
 
 
 
+  /**
+   * The state after the last finished cycle of the study of the output
+   * directory, from its checkpoint (Checkpoint): the mesh, its DoFs, u1h,
+   * u2h, λ_h and the indicators, what the report, the field output and
+   * balanced stopping carry on; the next cycle then starts as in the
+   * uninterrupted study, by refining this mesh. Returns that cycle.
+   */
+  template <int dim>
+  unsigned int
+  MembraneProblem<dim>::resume()
+  {
+    const CheckpointState state = checkpoint->load_mesh(*triangulation);
+    setup_system();
+    VectorType owned_lambda_h(discrete_problem.locally_owned_dofs(),
+                              mpi_communicator);
+    checkpoint->load_vectors(
+      dof_handler,
+      {{&solution.block(0), &solution.block(1), &owned_lambda_h}},
+      indicators);
+    ghosted_solution = solution;
+    lambda_h         = owned_lambda_h;
+    report.resume(state.cycle);
+    field_output.resume(state.solution_files, state.dual_mesh_files);
+    previous_record.mesh.cycle           = state.cycle;
+    previous_record.mesh.dofs            = state.dofs;
+    previous_record.estimator            = state.estimator;
+    previous_record.cumulative_wall_time = state.cumulative_wall_time;
+    pcout << "Resuming after cycle " << state.cycle << " (" << state.dofs
+          << " DoFs) from the checkpoint of " << parameters.output.directory
+          << std::endl;
+    return state.cycle + 1;
+  }
+
+
+
+  /**
+   * The checkpoint of cycle @p cycle, after every k-th cycle (`Output/
+   * Checkpoint every`) and after the last one of the run, so that a study
+   * can also be extended by more cycles.
+   */
+  template <int dim>
+  void
+  MembraneProblem<dim>::write_checkpoint(const unsigned int cycle)
+  {
+    const unsigned int every = parameters.output.checkpoint_every;
+    if (every == 0 ||
+        ((cycle + 1) % every != 0 && cycle + 1 != parameters.refinement.cycles))
+      return;
+    CheckpointState state;
+    state.cycle                = cycle;
+    state.dofs                 = record.mesh.dofs;
+    state.estimator            = record.estimator;
+    state.cumulative_wall_time = record.cumulative_wall_time;
+    std::tie(state.solution_files, state.dual_mesh_files) =
+      field_output.written_files();
+    Timer timer;
+    checkpoint->write(
+      state,
+      dof_handler,
+      {{&ghosted_solution.block(0), &ghosted_solution.block(1), &lambda_h}},
+      indicators);
+    pcout << "   checkpoint written in " << timer.wall_time() << " s"
+          << std::endl;
+  }
+
+
+
   template <int dim>
   void
   MembraneProblem<dim>::run()
@@ -675,8 +749,10 @@ namespace membranes
       pcout << "No effectivity index: it needs err_energy in Exact "
                "solution/Norms"
             << std::endl;
-    output_directory.claim();
-    for (unsigned int cycle = 0; cycle < parameters.refinement.cycles; ++cycle)
+    output_directory.claim(parameters.output.resume);
+    const unsigned int first_cycle = parameters.output.resume ? resume() : 0;
+    for (unsigned int cycle = first_cycle; cycle < parameters.refinement.cycles;
+         ++cycle)
       {
         record = CycleRecord();
         computing_timer.reset();
@@ -707,6 +783,7 @@ namespace membranes
         report.add(record);
         previous_record = record;
         output_results(cycle);
+        write_checkpoint(cycle);
         if (target_reached())
           break;
       }

@@ -15,6 +15,7 @@
 #include <membranes/dual_mesh/dual_mesh.h>
 #include <membranes/mesh/discrete_problem.h>
 #include <membranes/mesh/discretization.h>
+#include <membranes/output/checkpoint.h>
 #include <membranes/output/field_output.h>
 #include <membranes/output/output_directory.h>
 #include <membranes/output/report.h>
@@ -110,6 +111,10 @@ namespace membranes
     record_mesh(const unsigned int cycle);
     void
     record_costs();
+    unsigned int
+    resume();
+    void
+    write_checkpoint(const unsigned int cycle);
 
     const Parameters::All &parameters;
     MPI_Comm               mpi_communicator;
@@ -157,6 +162,11 @@ namespace membranes
     FieldOutput<dim>                         field_output;
     /** Held from the start of the first cycle to the end of the run. */
     OutputDirectory output_directory;
+    /**
+     * The checkpoint of the study, when the scene writes or resumes one
+     * (`Output/Checkpoint every`, `Output/Resume`).
+     */
+    std::unique_ptr<Checkpoint<dim>> checkpoint;
 
     /**
      * Carries (u1h, u2h, λ_h) from one mesh to the next: the distributed

@@ -131,6 +131,28 @@ namespace membranes
 
 
   template <int dim>
+  std::pair<std::vector<std::pair<double, std::string>>,
+            std::vector<std::pair<double, std::string>>>
+  FieldOutput<dim>::written_files() const
+  {
+    return {cycles_written, dual_mesh_cycles_written};
+  }
+
+
+
+  template <int dim>
+  void
+  FieldOutput<dim>::resume(
+    const std::vector<std::pair<double, std::string>> &solution_files,
+    const std::vector<std::pair<double, std::string>> &dual_mesh_files)
+  {
+    cycles_written           = solution_files;
+    dual_mesh_cycles_written = dual_mesh_files;
+  }
+
+
+
+  template <int dim>
   void
   FieldOutput<dim>::write_cycle(
     const unsigned int                         cycle,

@@ -4,11 +4,13 @@
 #include <exception>
 #include <fcntl.h>
 #include <filesystem>
+#include <fstream>
 #include <membranes/output/atomic_file.h>
 #include <membranes/output/output_directory.h>
 #include <membranes/scene/parameters.h>
 #include <membranes/version.h>
 #include <regex>
+#include <sstream>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -179,14 +181,17 @@ namespace membranes
 
 
   void
-  OutputDirectory::claim()
+  OutputDirectory::claim(const bool resume)
   {
     std::string problem;
     if (dealii::Utilities::MPI::this_mpi_process(mpi_communicator) == 0)
       try
         {
           lock();
-          remove_earlier_output();
+          if (resume)
+            check_resumed_scene();
+          else
+            remove_earlier_output();
           write_atomically(
             directory + "/" + parameters_name, [this](std::ostream &out) {
               out << "# The parameters of the run that wrote this "
@@ -277,6 +282,47 @@ namespace membranes
 
 
   void
+  OutputDirectory::check_resumed_scene() const
+  {
+    // The entries a resumed study may change: the number of cycles, and
+    // what the run writes where (but the fluxes, which are columns of the
+    // report).
+    static const std::vector<std::string> free{"Refinement/Cycles",
+                                               "Output/Directory",
+                                               "Output/Report",
+                                               "Output/Write vtu",
+                                               "Output/Write nodal values",
+                                               "Output/Checkpoint every",
+                                               "Output/Resume"};
+    std::ifstream                         in(directory + "/" + parameters_name);
+    if (!in)
+      throw Parameters::InputError("Output/Resume: " + directory +
+                                   " holds no study to resume (no " +
+                                   parameters_name + ")");
+    std::stringstream recorded;
+    recorded << in.rdbuf();
+    std::string difference;
+    try
+      {
+        difference = Parameters::first_difference(recorded.str(),
+                                                  provenance.parameters,
+                                                  free);
+      }
+    catch (const std::exception &error)
+      {
+        throw Parameters::InputError(
+          "Output/Resume: " + directory + "/" + parameters_name +
+          " does not read: " + Parameters::one_line_message(error));
+      }
+    if (!difference.empty())
+      throw Parameters::InputError(
+        "Output/Resume: the scene is not the one that wrote " + directory +
+        ": " + difference);
+  }
+
+
+
+  void
   OutputDirectory::remove_earlier_output() const
   {
     const fs::path path(directory);
@@ -290,6 +336,9 @@ namespace membranes
               continue;
             if (name == "unconverged" && remove_output_files(entry.path()))
               fs::remove(entry.path());
+            else if (std::regex_match(name,
+                                      std::regex("checkpoint(\\.tmp|\\.old)?")))
+              fs::remove_all(entry.path());
             else if (std::regex_match(name,
                                       std::regex("\\.membranes-probe-[0-9]+")))
               {

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <fstream>
 #include <iomanip>
 #include <membranes/output/atomic_file.h>
 #include <membranes/output/report.h>
@@ -112,32 +113,42 @@ namespace membranes
 
 
 
+  std::pair<std::vector<bool>, std::string>
+  Report::columns() const
+  {
+    // Every column but those against the exact solution that this run does
+    // not compute.
+    const std::vector<Field> names = row(CycleRecord());
+    std::vector<bool>        written(names.size());
+    std::string              header;
+    for (unsigned int c = 0; c < names.size(); ++c)
+      {
+        written[c] = names[c].norm.empty() || exact.computes(names[c].norm);
+        if (written[c])
+          header += (header.empty() ? "" : ",") + names[c].name;
+      }
+    return {written, header};
+  }
+
+
+
   void
   Report::add(const CycleRecord &record)
   {
     records.push_back(record);
     if (!parameters.report || !pcout.is_active())
       return;
-    // The columns of the file: every one but those against the exact
-    // solution that this run does not compute.
-    const std::vector<Field> names = row(CycleRecord());
-    std::vector<bool>        written(names.size());
-    for (unsigned int c = 0; c < names.size(); ++c)
-      written[c] = names[c].norm.empty() || exact.computes(names[c].norm);
+    const auto [written, header] = columns();
     write_atomically(parameters.directory + "/report.csv",
                      [&](std::ostream &out) {
-                       const char *separator = "";
-                       for (unsigned int c = 0; c < names.size(); ++c)
-                         if (written[c])
-                           {
-                             out << separator << names[c].name;
-                             separator = ",";
-                           }
-                       out << '\n' << std::setprecision(12);
+                       out << header << '\n';
+                       for (const std::string &line : earlier_rows)
+                         out << line << '\n';
+                       out << std::setprecision(12);
                        for (const CycleRecord &r : records)
                          {
-                           const auto fields = row(r);
-                           separator         = "";
+                           const auto  fields    = row(r);
+                           const char *separator = "";
                            for (unsigned int c = 0; c < fields.size(); ++c)
                              if (written[c])
                                {
@@ -149,6 +160,40 @@ namespace membranes
                            out << '\n';
                          }
                      });
+  }
+
+
+
+  void
+  Report::resume(const unsigned int last_cycle)
+  {
+    if (!parameters.report)
+      return;
+    // Every process reads the file, so that all stop alike if it does not
+    // fit.
+    const std::string name = parameters.directory + "/report.csv";
+    std::ifstream     in(name);
+    std::string       line;
+    if (!std::getline(in, line) || line != columns().second)
+      throw Parameters::CollectiveError(
+        "Output/Resume: " + name +
+        " is missing or has other columns than this scene writes");
+    while (std::getline(in, line))
+      {
+        const std::string cycle = line.substr(0, line.find(','));
+        if (cycle.empty() ||
+            cycle.find_first_not_of("0123456789") != std::string::npos)
+          throw Parameters::CollectiveError("Output/Resume: " + name +
+                                            " has a row that is not one: '" +
+                                            line + "'");
+        if (std::stoul(cycle) <= last_cycle)
+          earlier_rows.push_back(line);
+      }
+    if (earlier_rows.size() != last_cycle + 1)
+      throw Parameters::CollectiveError(
+        "Output/Resume: " + name + " holds " +
+        std::to_string(earlier_rows.size()) + " rows up to cycle " +
+        std::to_string(last_cycle) + ", the cycle of the checkpoint");
   }
 
 

@@ -612,7 +612,8 @@ namespace membranes::Parameters
                       "parameters.prm and run-info.txt; created if missing. "
                       "One run at a time holds it, and removes the files "
                       "that an earlier run wrote there (those only) before "
-                      "its first cycle.");
+                      "its first cycle, unless it resumes that run "
+                      "('Resume').");
     prm.declare_entry("Report",
                       "true",
                       Bool(),
@@ -638,6 +639,21 @@ namespace membranes::Parameters
                       "dual-mesh-NN.vtu. It is computed for this, and the "
                       "flux estimator with it; 'Refinement/Estimator = "
                       "flux' computes both without writing them.");
+    prm.declare_entry("Checkpoint every",
+                      "0",
+                      dealii::Patterns::Integer(0),
+                      "Keep in checkpoint/ of the output directory what the "
+                      "next cycle needs (the mesh, u1, u2, lambda_h and the "
+                      "indicators) after every k-th cycle and the last; 0 "
+                      "keeps none. Only the last checkpoint is kept.");
+    prm.declare_entry("Resume",
+                      "false",
+                      Bool(),
+                      "Continue the study of the output directory from its "
+                      "checkpoint, with the cycle after it, appending to "
+                      "report.csv and the .pvd files (also: --resume). The "
+                      "scene must be the one that wrote it, but for "
+                      "'Refinement/Cycles' and the entries of 'Output'.");
     prm.leave_subsection();
   }
 
@@ -652,6 +668,8 @@ namespace membranes::Parameters
     write_vtu           = prm.get_bool("Write vtu");
     write_nodal_values  = prm.get_bool("Write nodal values");
     flux_reconstruction = prm.get_bool("Flux reconstruction");
+    checkpoint_every    = prm.get_integer("Checkpoint every");
+    resume              = prm.get_bool("Resume");
     prm.leave_subsection();
   }
 

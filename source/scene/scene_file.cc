@@ -561,7 +561,54 @@ namespace membranes::Parameters
           }
       return {};
     }
+
+    /** Every entry of @p tree below @p path: (`A/B/entry`, value). */
+    void
+    entries_of(const ptree                                      &tree,
+               const std::vector<std::string>                   &path,
+               std::vector<std::pair<std::string, std::string>> &entries)
+    {
+      for (const auto &[name, node] : tree)
+        if (is_entry(node))
+          entries.emplace_back(joined(path, name),
+                               node.get<std::string>("value"));
+        else
+          {
+            std::vector<std::string> below = path;
+            below.push_back(name);
+            entries_of(node, below, entries);
+          }
+    }
+
+    /** The entries of the parameter file @p text (of parameter_file()). */
+    std::vector<std::pair<std::string, std::string>>
+    entries_of(const std::string &text)
+    {
+      ParameterHandler prm;
+      All::declare_parameters(prm);
+      prm.parse_input_from_string(text);
+      std::vector<std::pair<std::string, std::string>> entries;
+      entries_of(tree_of(prm), {}, entries);
+      return entries;
+    }
   } // namespace
+
+
+
+  std::string
+  first_difference(const std::string              &recorded,
+                   const std::string              &current,
+                   const std::vector<std::string> &free)
+  {
+    const auto before = entries_of(recorded);
+    const auto now    = entries_of(current);
+    for (unsigned int i = 0; i < before.size() && i < now.size(); ++i)
+      if (std::find(free.begin(), free.end(), now[i].first) == free.end() &&
+          before[i] != now[i])
+        return "'" + now[i].first + "' is '" + now[i].second +
+               "' here and was '" + before[i].second + "'";
+    return "";
+  }
 
 
 

@@ -78,6 +78,22 @@ namespace membranes
                     const std::vector<DataOutBase::Patch<dim, dim>> &patches,
                     const std::vector<std::string>                  &names);
 
+    /**
+     * The records of solution.pvd and dual-mesh.pvd so far: (cycle, file)
+     * pairs, for a checkpoint (Checkpoint::State).
+     */
+    std::pair<std::vector<std::pair<double, std::string>>,
+              std::vector<std::pair<double, std::string>>>
+    written_files() const;
+
+    /**
+     * Continue solution.pvd and dual-mesh.pvd with the records
+     * @p solution_files and @p dual_mesh_files of a resumed study.
+     */
+    void
+    resume(const std::vector<std::pair<double, std::string>> &solution_files,
+           const std::vector<std::pair<double, std::string>> &dual_mesh_files);
+
   private:
     /**
      * The fields written besides u1h, u2h and λ_h, ghosted vectors on the

@@ -79,10 +79,12 @@ namespace membranes
 
     /**
      * Claim the directory as the class documentation says; a
-     * Parameters::CollectiveError if it is in use or any step fails.
+     * Parameters::CollectiveError if it is in use or any step fails. With
+     * @p resume, the earlier output stays, and the scene must be the one
+     * that wrote it (check_resumed_scene()).
      */
     void
-    claim();
+    claim(const bool resume);
 
   private:
     /**
@@ -94,15 +96,26 @@ namespace membranes
     lock();
 
     /**
+     * That the parameters.prm of the directory records the scene of this
+     * run but for the number of cycles and the entries of `Output` that
+     * say what is written where; an InputError naming the first entry that
+     * differs otherwise.
+     */
+    void
+    check_resumed_scene() const;
+
+    /**
      * Remove what an earlier run of the program wrote into the directory,
      * recognized by name and kind: the regular files report.csv,
      * solution-NN.vtu, solution-NN.PPPP.vtu, solution-NN.pvtu,
      * solution.pvd, the same of dual-mesh, nodal-values-NN.csv,
      * parameters.prm and run-info.txt, each also with the suffix .tmp of an
      * interrupted write (write_atomically()); the directory unconverged/
-     * with the same files in it (it stays if anything else is in it); and
-     * the empty directories .membranes-probe-PID that a run killed in its
-     * check of the output directory may leave. Nothing else is touched.
+     * with the same files in it (it stays if anything else is in it); the
+     * checkpoint directories checkpoint/, checkpoint.tmp/ and
+     * checkpoint.old/ (Checkpoint); and the empty directories
+     * .membranes-probe-PID that a run killed in its check of the output
+     * directory may leave. Nothing else is touched.
      */
     void
     remove_earlier_output() const;

@@ -175,6 +175,17 @@ namespace membranes
     add(const CycleRecord &record);
 
     /**
+     * Continue the report.csv of the output directory (a resumed study):
+     * its rows of the cycles up to @p last_cycle come before those that
+     * add() adds; later rows (of a cycle that ran after the checkpoint) go.
+     * A file with other columns, or without these rows, is a
+     * Parameters::CollectiveError. The terminal's table of rates covers
+     * the cycles of this run.
+     */
+    void
+    resume(const unsigned int last_cycle);
+
+    /**
      * Print the table with the observed convergence rates of the error
      * columns, computed by ConvergenceTable against `dofs`: with
      * @p rates_in_dofs the rate r of e ~ N^(−r) in the number N of DoFs
@@ -186,10 +197,16 @@ namespace membranes
     print_convergence_table(const bool rates_in_dofs);
 
   private:
+    /** Which columns of a row the file has (see add()), and its header. */
+    std::pair<std::vector<bool>, std::string>
+    columns() const;
+
     const Parameters::Output        &parameters;
     const Parameters::ExactSolution &exact;
     const ConditionalOStream        &pcout;
     std::vector<CycleRecord>         records;
+    /** The rows of report.csv from before a resumed study, as written. */
+    std::vector<std::string> earlier_rows;
   };
 } // namespace membranes
 

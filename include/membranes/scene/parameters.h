@@ -116,6 +116,19 @@ namespace membranes::Parameters
   std::string
   parameter_file(const ParameterHandler &prm);
 
+  /**
+   * The first entry, in declaration order, whose value differs between the
+   * parameter files @p recorded and @p current (both of parameter_file()),
+   * leaving out the entries @p free (`Subsection/Entry`), as
+   * "'Sub/Entry' is 'a' here and was 'b'"; empty if there is none. An
+   * entry that @p recorded cannot hold is an exception of
+   * ParameterHandler.
+   */
+  std::string
+  first_difference(const std::string              &recorded,
+                   const std::string              &current,
+                   const std::vector<std::string> &free);
+
   enum class Domain
   {
     square,
@@ -333,6 +346,9 @@ namespace membranes::Parameters
     bool        write_vtu;   ///< Write VTU files and a .pvd over cycles.
     bool write_nodal_values; ///< Write the nodal values as CSV, full precision.
     bool flux_reconstruction; ///< Compute and write the fluxes t_ih.
+    /** Write a checkpoint after every k-th cycle and the last; 0: none. */
+    unsigned int checkpoint_every;
+    bool         resume; ///< Continue from the checkpoint of the directory.
 
     static void
     declare_parameters(ParameterHandler &prm);
