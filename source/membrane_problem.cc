@@ -683,7 +683,10 @@ namespace membranes
   unsigned int
   MembraneProblem<dim>::resume()
   {
-    const CheckpointState state = checkpoint->load_mesh(*triangulation);
+    const CheckpointState state =
+      checkpoint->load_mesh(*triangulation, [this](Triangulation<dim> &mesh) {
+        create_mesh(parameters.geometry, mesh);
+      });
     setup_system();
     VectorType owned_lambda_h(discrete_problem.locally_owned_dofs(),
                               mpi_communicator);

@@ -12,6 +12,7 @@
 #include <membranes/output/checkpoint.h>
 #include <membranes/scene/parameters.h>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <tuple>
 
@@ -27,6 +28,8 @@ namespace membranes
     const std::string state_name  = "state.txt";
     /** The file of a mesh that every process holds whole. */
     const std::string replicated_name = "replicated.bin";
+    /** The refinements of a p4est mesh, by the CellIds of their cells. */
+    const std::string history_name = "history.bin";
 
     /**
      * A 64-bit hash of the bytes of the file @p path: FNV-1a over its
@@ -223,7 +226,27 @@ namespace membranes
   {
     if (dynamic_cast<const parallel::distributed::Triangulation<dim> *>(
           &triangulation) != nullptr)
-      return;
+      {
+        // The cells of a p4est mesh by their CellId, which names a cell on
+        // any partition; all of them on the first process, which writes
+        // them.
+        std::array<std::vector<unsigned int>, 2> flagged;
+        for (const auto &cell : triangulation.active_cell_iterators())
+          if (cell->is_locally_owned())
+            for (unsigned int f = 0; f < 2; ++f)
+              if (f == 0 ? cell->refine_flag_set() : cell->coarsen_flag_set())
+                {
+                  const auto id = cell->id().template to_binary<dim>();
+                  flagged[f].insert(flagged[f].end(), id.begin(), id.end());
+                }
+        std::array<std::vector<unsigned int>, 2> all;
+        for (unsigned int f = 0; f < 2; ++f)
+          for (const auto &part :
+               Utilities::MPI::gather(mpi_communicator, flagged[f], 0))
+            all[f].insert(all[f].end(), part.begin(), part.end());
+        cell_refinements.emplace_back(all[0], all[1]);
+        return;
+      }
     refinements.emplace_back();
     triangulation.save_refine_flags(refinements.back().first);
     triangulation.save_coarsen_flags(refinements.back().second);
@@ -258,21 +281,10 @@ namespace membranes
       dynamic_cast<const parallel::distributed::Triangulation<dim> *>(
         &dof_handler.get_triangulation());
     if (distributed != nullptr)
-      {
-        // The nodal values of each locally owned cell and its indicator,
-        // one fixed-size record per cell that p4est's save() writes
-        // with the cell (parallel::distributed::SolutionTransfer, which
-        // packs a variable-length vector per cell and vector, takes ten
-        // times as long).
-        const auto records = cell_records(dof_handler, vectors, indicators);
-        parallel::distributed::
-          CellDataTransfer<dim, dim, std::vector<CellRecord>>
-            transfer(*distributed);
-        transfer.prepare_for_serialization(records);
-        distributed->save(written + "/mesh");
-      }
+      problem = write_distributed(written, dof_handler, vectors, indicators);
     else
-      write_replicated(written, dof_handler, vectors, indicators);
+      problem = write_replicated(written, dof_handler, vectors, indicators);
+    throw_collective(problem, mpi_communicator);
     const int ierr = MPI_Barrier(mpi_communicator);
     AssertThrowMPI(ierr);
 
@@ -363,7 +375,43 @@ namespace membranes
 
 
   template <int dim>
-  void
+  std::string
+  Checkpoint<dim>::write_distributed(
+    const std::string                       &directory,
+    const DoFHandler<dim>                   &dof_handler,
+    const std::array<const VectorType *, 3> &vectors,
+    const Vector<double>                    &indicators) const
+  {
+    // The nodal values of each locally owned cell and its indicator, one
+    // fixed-size record per cell that p4est's save() writes with the cell
+    // (parallel::distributed::SolutionTransfer, which packs a
+    // variable-length vector per cell and vector, takes twice as long).
+    const auto &triangulation =
+      dynamic_cast<const parallel::distributed::Triangulation<dim> &>(
+        dof_handler.get_triangulation());
+    const auto records = cell_records(dof_handler, vectors, indicators);
+    parallel::distributed::CellDataTransfer<dim, dim, std::vector<CellRecord>>
+      transfer(triangulation);
+    transfer.prepare_for_serialization(records);
+    triangulation.save(directory + "/mesh");
+    if (Utilities::MPI::this_mpi_process(mpi_communicator) != 0)
+      return "";
+    std::ofstream out(directory + "/" + history_name, std::ios::binary);
+    write_binary(out, std::vector<std::uint64_t>{cell_refinements.size()});
+    for (const auto &[refine, coarsen] : cell_refinements)
+      {
+        write_binary(out, refine);
+        write_binary(out, coarsen);
+      }
+    return out.flush() ? "" :
+                         "cannot write a checkpoint: cannot write " +
+                           directory + "/" + history_name;
+  }
+
+
+
+  template <int dim>
+  std::string
   Checkpoint<dim>::write_replicated(
     const std::string                       &directory,
     const DoFHandler<dim>                   &dof_handler,
@@ -393,7 +441,7 @@ namespace membranes
     Utilities::MPI::sum(all_indicators, mpi_communicator, all_indicators);
 
     if (Utilities::MPI::this_mpi_process(mpi_communicator) != 0)
-      return;
+      return "";
     std::ofstream out(directory + "/" + replicated_name, std::ios::binary);
     write_binary(out,
                  std::vector<std::uint64_t>{refinements.size(), n_vertices});
@@ -404,9 +452,9 @@ namespace membranes
       }
     write_binary(out, by_vertex);
     write_binary(out, all_indicators);
-    if (!out.flush())
-      throw std::runtime_error("cannot write " + directory + "/" +
-                               replicated_name);
+    return out.flush() ? "" :
+                         "cannot write a checkpoint: cannot write " +
+                           directory + "/" + replicated_name;
   }
 
 
@@ -425,7 +473,9 @@ namespace membranes
 
   template <int dim>
   typename Checkpoint<dim>::State
-  Checkpoint<dim>::load_mesh(Triangulation<dim> &triangulation)
+  Checkpoint<dim>::load_mesh(
+    Triangulation<dim>                              &triangulation,
+    const std::function<void(Triangulation<dim> &)> &make_coarse_mesh)
   {
     const std::string directory = readable_directory();
     auto *const       distributed =
@@ -442,13 +492,11 @@ namespace membranes
 
     if (distributed != nullptr)
       {
-        // The cells of each process as saved, if the number of processes is
-        // the same (a new partition would change the order of sums and the
-        // AMG hierarchies of the next cycle); p4est partitions them anew
-        // otherwise.
-        distributed->load(directory + "/mesh",
-                          file.processes !=
-                            Utilities::MPI::n_mpi_processes(mpi_communicator));
+        load_distributed(*distributed,
+                         directory,
+                         file.processes ==
+                           Utilities::MPI::n_mpi_processes(mpi_communicator),
+                         make_coarse_mesh);
         return state;
       }
     std::ifstream in(directory + "/" + replicated_name, std::ios::binary);
@@ -473,6 +521,74 @@ namespace membranes
 
   template <int dim>
   void
+  Checkpoint<dim>::load_distributed(
+    parallel::distributed::Triangulation<dim>       &triangulation,
+    const std::string                               &directory,
+    const bool                                       same_processes,
+    const std::function<void(Triangulation<dim> &)> &make_coarse_mesh)
+  {
+    // The saved mesh, with the cells of each process as saved if the number
+    // of processes is the same, and the record of each locally owned cell
+    // by its CellId.
+    triangulation.load(directory + "/mesh", !same_processes);
+    std::vector<CellRecord> records(triangulation.n_active_cells());
+    parallel::distributed::CellDataTransfer<dim, dim, std::vector<CellRecord>>
+      transfer(triangulation);
+    transfer.deserialize(records);
+    loaded_records.clear();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        loaded_records.emplace(cell->id().template to_binary<dim>(),
+                               records[cell->active_cell_index()]);
+
+    std::ifstream in(directory + "/" + history_name, std::ios::binary);
+    const auto    n_refinements = read_binary<std::uint64_t>(in);
+    cell_refinements.clear();
+    for (std::uint64_t r = 0; r < n_refinements->at(0); ++r)
+      {
+        auto refine  = read_binary<unsigned int>(in);
+        auto coarsen = read_binary<unsigned int>(in);
+        cell_refinements.emplace_back(std::move(*refine), std::move(*coarsen));
+      }
+    if (!same_processes)
+      return;
+    // On as many processes as before, the mesh made again by its
+    // refinements: its cells in the order in which they were made, so that
+    // the DoFs are numbered as in the study that wrote the checkpoint (the
+    // loaded mesh numbers them in p4est's order). The partition is that of
+    // the loaded one, whose records each process holds.
+    triangulation.clear();
+    make_coarse_mesh(triangulation);
+    for (const auto &[refine, coarsen] : cell_refinements)
+      {
+        std::array<std::set<CellId::binary_type>, 2> flagged;
+        for (unsigned int f = 0; f < 2; ++f)
+          for (std::size_t i = 0; i < (f == 0 ? refine : coarsen).size();
+               i += 4)
+            {
+              CellId::binary_type id;
+              std::copy_n((f == 0 ? refine : coarsen).begin() + i,
+                          4,
+                          id.begin());
+              flagged[f].insert(id);
+            }
+        for (const auto &cell : triangulation.active_cell_iterators())
+          if (cell->is_locally_owned())
+            {
+              const auto id = cell->id().template to_binary<dim>();
+              if (flagged[0].count(id) > 0)
+                cell->set_refine_flag();
+              if (flagged[1].count(id) > 0)
+                cell->set_coarsen_flag();
+            }
+        triangulation.execute_coarsening_and_refinement();
+      }
+  }
+
+
+
+  template <int dim>
+  void
   Checkpoint<dim>::load_vectors(const DoFHandler<dim>             &dof_handler,
                                 const std::array<VectorType *, 3> &vectors,
                                 Vector<double>                    &indicators)
@@ -485,17 +601,20 @@ namespace membranes
       has_indicators ? dof_handler.get_triangulation().n_active_cells() : 0);
     if (distributed != nullptr)
       {
-        std::vector<CellRecord> records(
-          dof_handler.get_triangulation().n_active_cells());
-        parallel::distributed::
-          CellDataTransfer<dim, dim, std::vector<CellRecord>>
-            transfer(*distributed);
-        transfer.deserialize(records);
-        const IndexSet &owned = dof_handler.locally_owned_dofs();
+        // A cell without a record: the mesh made again is not the saved one.
+        bool            complete = true;
+        const IndexSet &owned    = dof_handler.locally_owned_dofs();
         for (const auto &cell : dof_handler.active_cell_iterators())
           if (cell->is_locally_owned())
             {
-              const CellRecord &record = records[cell->active_cell_index()];
+              const auto found =
+                loaded_records.find(cell->id().template to_binary<dim>());
+              if (found == loaded_records.end())
+                {
+                  complete = false;
+                  continue;
+                }
+              const CellRecord &record = found->second;
               for (const unsigned int v : cell->vertex_indices())
                 if (const auto dof = cell->vertex_dof_index(v, 0);
                     owned.is_element(dof))
@@ -504,6 +623,11 @@ namespace membranes
               if (has_indicators)
                 indicators[cell->active_cell_index()] = record.back();
             }
+        loaded_records.clear();
+        if (Utilities::MPI::logical_or(!complete, mpi_communicator))
+          throw Parameters::CollectiveError(
+            "the checkpoint " + directory +
+            " is damaged: its refinements do not make its mesh");
         for (VectorType *vector : vectors)
           vector->compress(VectorOperation::insert);
         return;

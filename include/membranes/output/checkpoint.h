@@ -4,10 +4,14 @@
 #include <array>
 #include <deal.II/base/geometry_info.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/grid/cell_id.h>
 #include <deal.II/grid/tria.h>
 #include <deal.II/lac/trilinos_vector.h>
 #include <deal.II/lac/vector.h>
+#include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -48,14 +52,15 @@ namespace membranes
    * - a p4est mesh (quadrilaterals) by
    *   parallel::distributed::Triangulation::save(), each locally owned
    *   cell with a CellRecord (the nodal values at its vertices and its
-   *   indicator, attached by CellDataTransfer); load() on any number of
-   *   processes (p4est partitions the cells anew if it differs) and
-   *   deserialization. The loaded mesh numbers its cells, and so its DoFs,
-   *   in p4est's order rather than in the order in which the refinements
-   *   made them: where adaptive refinement made the mesh, the resumed run
-   *   agrees with the uninterrupted one to the algebraic error of CG-AMG
-   *   (to round-off with a direct solver), where global refinement made
-   *   it, to round-off;
+   *   indicator, attached by CellDataTransfer), and by its history: the
+   *   CellIds of the cells flagged in every refinement. On as many
+   *   processes as wrote it, the saved mesh is loaded with its partition,
+   *   each process keeps the records of its cells, and the mesh is made
+   *   again from the coarse one by its refinements, so that its cells, and
+   *   its DoFs, are numbered as in the uninterrupted study (the loaded mesh
+   *   numbers them in p4est's order, and CG-AMG's iterates would differ by
+   *   their algebraic error). On another number of processes the loaded
+   *   mesh is used as it is, partitioned anew by p4est;
    * - a mesh that every process holds whole (triangles, a
    *   parallel::shared::Triangulation) by its history: the refine and
    *   coarsen flags of every refinement since the coarse mesh, replayed on
@@ -108,7 +113,9 @@ namespace membranes
      * Parameters::CollectiveError before anything is changed. Collective.
      */
     State
-    load_mesh(Triangulation<dim> &triangulation);
+    load_mesh(
+      Triangulation<dim>                              &triangulation,
+      const std::function<void(Triangulation<dim> &)> &make_coarse_mesh);
 
     /**
      * After load_mesh() and the distribution of the DoFs of @p dof_handler
@@ -135,12 +142,35 @@ namespace membranes
                  const std::array<const VectorType *, 3> &vectors,
                  const Vector<double>                    &indicators) const;
 
+    /**
+     * load_mesh() of a p4est mesh: the saved mesh and the records of its
+     * locally owned cells, then, on @p same_processes as wrote it, the mesh
+     * made again from the coarse one of @p make_coarse_mesh by the
+     * refinements since (see the class documentation).
+     */
+    void
+    load_distributed(
+      parallel::distributed::Triangulation<dim>       &triangulation,
+      const std::string                               &directory,
+      const bool                                       same_processes,
+      const std::function<void(Triangulation<dim> &)> &make_coarse_mesh);
+
     /** The directory of the checkpoint to read: checkpoint/, or .old/. */
     std::string
     readable_directory() const;
 
-    /** Write the files of a mesh that every process holds whole. */
-    void
+    /**
+     * Write the files of a p4est mesh into @p directory; what went wrong
+     * on the first process, empty if nothing.
+     */
+    std::string
+    write_distributed(const std::string                       &directory,
+                      const DoFHandler<dim>                   &dof_handler,
+                      const std::array<const VectorType *, 3> &vectors,
+                      const Vector<double> &indicators) const;
+
+    /** The same for a mesh that every process holds whole. */
+    std::string
     write_replicated(const std::string                       &directory,
                      const DoFHandler<dim>                   &dof_handler,
                      const std::array<const VectorType *, 3> &vectors,
@@ -155,6 +185,15 @@ namespace membranes
      * process holds whole, from the coarse mesh on.
      */
     std::vector<std::pair<std::vector<bool>, std::vector<bool>>> refinements;
+    /**
+     * The same for a p4est mesh: the CellIds (CellId::to_binary(), four
+     * numbers each) of the cells flagged for refinement and for coarsening
+     * in every refinement, all processes' on the first one.
+     */
+    std::vector<std::pair<std::vector<unsigned int>, std::vector<unsigned int>>>
+      cell_refinements;
+    /** The CellRecord of each locally owned cell of the checkpoint read. */
+    std::map<CellId::binary_type, CellRecord> loaded_records;
   };
 } // namespace membranes
 
