@@ -435,9 +435,10 @@ namespace membranes
                 (*vectors[k])[dof];
     Utilities::MPI::sum(by_vertex, mpi_communicator, by_vertex);
     std::vector<double> all_indicators(indicators.begin(), indicators.end());
-    for (const auto &cell : triangulation.active_cell_iterators())
-      if (!all_indicators.empty() && !cell->is_locally_owned())
-        all_indicators[cell->active_cell_index()] = 0;
+    if (!all_indicators.empty())
+      for (const auto &cell : triangulation.active_cell_iterators())
+        if (!cell->is_locally_owned())
+          all_indicators[cell->active_cell_index()] = 0;
     Utilities::MPI::sum(all_indicators, mpi_communicator, all_indicators);
 
     if (Utilities::MPI::this_mpi_process(mpi_communicator) != 0)
@@ -514,6 +515,8 @@ namespace membranes
         triangulation.execute_coarsening_and_refinement();
         complete_ghost_layer(triangulation);
       }
+    loaded_by_vertex  = *read_binary<double>(in);
+    loaded_indicators = *read_binary<double>(in);
     return state;
   }
 
@@ -633,14 +636,9 @@ namespace membranes
         return;
       }
 
-    std::ifstream in(directory + "/" + replicated_name, std::ios::binary);
-    const auto    sizes = read_binary<std::uint64_t>(in);
-    for (std::uint64_t r = 0; r < 2 * sizes->at(0); ++r)
-      read_binary<char>(in);
-    const auto         by_vertex      = read_binary<double>(in);
-    const auto         all_indicators = read_binary<double>(in);
-    const unsigned int n_vertices     = sizes->at(1);
-    const IndexSet    &owned          = dof_handler.locally_owned_dofs();
+    // The values that load_mesh() read with the refinements.
+    const unsigned int n_vertices = loaded_by_vertex.size() / 3;
+    const IndexSet    &owned      = dof_handler.locally_owned_dofs();
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         for (const unsigned int v : cell->vertex_indices())
@@ -648,12 +646,14 @@ namespace membranes
               owned.is_element(dof))
             for (unsigned int k = 0; k < 3; ++k)
               (*vectors[k])[dof] =
-                (*by_vertex)[k * n_vertices + cell->vertex_index(v)];
+                loaded_by_vertex[k * n_vertices + cell->vertex_index(v)];
     for (VectorType *vector : vectors)
       vector->compress(VectorOperation::insert);
-    std::copy(all_indicators->begin(),
-              all_indicators->end(),
+    std::copy(loaded_indicators.begin(),
+              loaded_indicators.end(),
               indicators.begin());
+    loaded_by_vertex.clear();
+    loaded_indicators.clear();
   }
 
 

@@ -194,6 +194,11 @@ namespace membranes
       cell_refinements;
     /** The CellRecord of each locally owned cell of the checkpoint read. */
     std::map<CellId::binary_type, CellRecord> loaded_records;
+    /**
+     * Of a mesh that every process holds whole: u1h, u2h and λ_h by vertex
+     * index, and the indicators, from load_mesh() to load_vectors().
+     */
+    std::vector<double> loaded_by_vertex, loaded_indicators;
   };
 } // namespace membranes
 
